@@ -1,0 +1,14 @@
+//! Finite elements: quadrature, shape functions, the isotropic material, sparse assembly of the
+//! scalar mass matrix `Ms` (`M = Ms ⊗ I3`), the small-strain stiffness `K` and lumped masses.
+//! DOF numbering everywhere: `3 * node + direction`.
+
+pub mod assembly;
+pub mod element;
+pub mod material;
+pub mod modal;
+pub mod quadrature;
+pub mod sparse;
+
+pub use assembly::{lumped_masses, scalar_mass_matrix, stiffness_matrix};
+pub use material::IsotropicMaterial;
+pub use sparse::SymmetricCsr;

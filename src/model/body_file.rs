@@ -1,0 +1,190 @@
+//! The body file (`resources/body.json`, DESIGN.md section 5): mesh, material defaults,
+//! interfaces, damping, gravity and solver defaults. The default body (B1 of BENCHMARKS.md: a
+//! clamped steel cantilever with a force interface `tip`) is embedded in the binary.
+
+use crate::error::{Error, Result};
+use crate::mesh::{ElementKind, NodeSelector};
+use serde::{Deserialize, Serialize};
+
+/// The embedded default body.
+pub const DEFAULT_BODY_JSON: &str = include_str!("../../examples/cantilever.json");
+
+/// A body file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct BodyFile {
+    /// Model name shown by importers.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub mesh: MeshSpec,
+    pub material: MaterialSpec,
+    #[serde(default)]
+    pub damping: DampingSpec,
+    /// Gravitational acceleration (m/s²), global frame.
+    #[serde(default)]
+    pub gravity: [f64; 3],
+    /// Supports and interfaces, each with a unique name.
+    pub interfaces: Vec<InterfaceSpec>,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub model: ModelSpec,
+}
+
+/// The mesh of the body.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub enum MeshSpec {
+    /// Structured box `[0, length] × [−width/2, width/2] × [−height/2, height/2]` (m).
+    Beam {
+        length: f64,
+        width: f64,
+        height: f64,
+        /// Elements along x, y, z.
+        divisions: [usize; 3],
+        element: ElementKind,
+    },
+}
+
+/// Material defaults (the FMU's `material.*` parameters start here).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub youngs_modulus: f64,
+    pub poisson_ratio: f64,
+    pub density: f64,
+}
+
+/// Rayleigh damping of the deformation, `f_d = hR (α M + β K) dū/dt`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct DampingSpec {
+    #[serde(default)]
+    pub alpha: f64,
+    #[serde(default)]
+    pub beta: f64,
+}
+
+/// What an interface does (DESIGN.md section 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum InterfaceKind {
+    /// Inputs force and torque, distributed RBE3-like; outputs the power-conjugate motion.
+    Force,
+    /// Clamps the node set where the body was placed; outputs the reaction.
+    Fixed,
+}
+
+/// A support or interface: a named node set with a reference point.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct InterfaceSpec {
+    pub name: String,
+    pub kind: InterfaceKind,
+    pub nodes: NodeSelector,
+    /// Reference point in body coordinates (m); default: the mass-weighted centroid of the nodes.
+    #[serde(default)]
+    pub reference_point: Option<[f64; 3]>,
+}
+
+/// Solver defaults (the FMU's `solver.*` parameters start here).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct SolverSpec {
+    /// Largest internal step (s).
+    #[serde(default = "SolverSpec::default_step_size")]
+    pub step_size: f64,
+    /// Generalized-α spectral radius at infinite frequency.
+    #[serde(default = "SolverSpec::default_rho_inf")]
+    pub rho_inf: f64,
+    /// Relative tolerance of the fixed-point iteration.
+    #[serde(default = "SolverSpec::default_tolerance")]
+    pub tolerance: f64,
+    #[serde(default = "SolverSpec::default_max_iterations")]
+    pub max_iterations: u32,
+}
+
+impl SolverSpec {
+    fn default_step_size() -> f64 {
+        1e-3
+    }
+    fn default_rho_inf() -> f64 {
+        0.9
+    }
+    fn default_tolerance() -> f64 {
+        1e-10
+    }
+    fn default_max_iterations() -> u32 {
+        25
+    }
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            step_size: Self::default_step_size(),
+            rho_inf: Self::default_rho_inf(),
+            tolerance: Self::default_tolerance(),
+            max_iterations: Self::default_max_iterations(),
+        }
+    }
+}
+
+/// Model switches.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct ModelSpec {
+    /// Include the nonlinear internal force `f_nl` (DESIGN.md section 2). Off by default.
+    #[serde(default)]
+    pub nonlinear_forces: bool,
+}
+
+impl BodyFile {
+    /// Parses and checks a body file; the error says what is wrong and where.
+    pub fn from_json(text: &str) -> Result<BodyFile> {
+        let body: BodyFile = serde_json::from_str(text)
+            .map_err(|e| Error::new(format!("body file: {e}")))?;
+        body.check()?;
+        Ok(body)
+    }
+
+    /// The embedded default body (B1).
+    pub fn default_body() -> BodyFile {
+        BodyFile::from_json(DEFAULT_BODY_JSON).expect("the embedded default body is valid")
+    }
+
+    /// Canonical JSON text (used for the GUID).
+    pub fn to_canonical_json(&self) -> String {
+        serde_json::to_string(self).expect("a body file serializes")
+    }
+
+    /// Checks what serde cannot: unique, FMI-safe interface names, at least one interface.
+    pub fn check(&self) -> Result<()> {
+        let mut seen = std::collections::BTreeSet::new();
+        for i in &self.interfaces {
+            let ok = !i.name.is_empty()
+                && i.name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+                && i.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            if !ok {
+                return Err(Error::new(format!(
+                    "body file: interface name '{}' must start with a letter and contain only letters, digits and '_'",
+                    i.name
+                )));
+            }
+            if matches!(i.name.as_str(), "body" | "material" | "damping" | "gravity" | "initial" | "solver" | "model") {
+                return Err(Error::new(format!(
+                    "body file: interface name '{}' is reserved for the FMU's own variables",
+                    i.name
+                )));
+            }
+            if !seen.insert(i.name.as_str()) {
+                return Err(Error::new(format!(
+                    "body file: interface name '{}' is used twice",
+                    i.name
+                )));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,1 @@
+//! Generalized-α time integration with the constant iteration matrix (DESIGN.md section 3).

@@ -1,0 +1,6 @@
+//! Time integration: the constant iteration matrix and its sparse Cholesky factor, generalized-α.
+
+pub mod cholesky;
+pub mod generalized_alpha;
+
+pub use cholesky::SparseCholesky;
