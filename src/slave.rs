@@ -2,33 +2,270 @@
 //! save and restore. Knows nothing of C pointers: the FMI glue in `fmi2` calls it after checking
 //! arguments and the calling sequence.
 
-use crate::error::Result;
-use crate::model::{BodyFile, VariableTable};
+use crate::body::frame::{nearest_rotation, node, set_node};
+use crate::body::interface::InterfaceMotion;
+use crate::body::{Body, BodyOptions, NodeSet};
+use crate::error::{Error, ErrorKind, Result};
+use crate::fem::{self, IsotropicMaterial};
+use crate::mesh::{self, Mesh};
+use crate::model::body_file::MeshSpec;
+use crate::model::model_description::{model_description, ModelInfo};
+use crate::model::variables::{FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
+use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
+use crate::solver::generalized_alpha::{
+    self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
+    StepWorkspace,
+};
+use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 
-/// A snapshot of everything that determines later steps (time, positions, velocities,
-/// accelerations, inputs, tunable parameters). Restoring it reproduces later steps bit for bit.
+/// Most factorizations kept (one per internal step size in use).
+const MATRIX_CACHE_SIZE: usize = 4;
+
+/// The parameters of DESIGN.md section 4 (SI units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameters {
+    pub material: IsotropicMaterial,
+    pub damping_alpha: f64,
+    pub damping_beta: f64,
+    pub gravity: [f64; 3],
+    pub initial_position: [f64; 3],
+    /// Row-major.
+    pub initial_rotation: [f64; 9],
+    pub initial_velocity: [f64; 3],
+    pub initial_angular_velocity: [f64; 3],
+    pub step_size: f64,
+    pub rho_inf: f64,
+    pub tolerance: f64,
+    pub max_iterations: i32,
+    pub nonlinear_forces: bool,
+}
+
+impl Parameters {
+    fn from_body_file(b: &BodyFile) -> Parameters {
+        Parameters {
+            material: IsotropicMaterial {
+                youngs_modulus: b.material.youngs_modulus,
+                poisson_ratio: b.material.poisson_ratio,
+                density: b.material.density,
+            },
+            damping_alpha: b.damping.alpha,
+            damping_beta: b.damping.beta,
+            gravity: b.gravity,
+            initial_position: [0.0; 3],
+            initial_rotation: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            initial_velocity: [0.0; 3],
+            initial_angular_velocity: [0.0; 3],
+            step_size: b.solver.step_size,
+            rho_inf: b.solver.rho_inf,
+            tolerance: b.solver.tolerance,
+            max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
+            nonlinear_forces: b.model.nonlinear_forces,
+        }
+    }
+
+    /// The parameters that the assembled model depends on (everything but gravity, the initial
+    /// placement and the iteration settings).
+    fn model_key(&self) -> (IsotropicMaterial, [u64; 4], bool) {
+        (
+            self.material,
+            [
+                self.damping_alpha.to_bits(),
+                self.damping_beta.to_bits(),
+                self.rho_inf.to_bits(),
+                self.step_size.to_bits(),
+            ],
+            self.nonlinear_forces,
+        )
+    }
+
+    /// Checks one Real parameter value; the error names the variable, the value and the reason.
+    fn check_real(name: &str, key: FixedKey, value: f64) -> Result<()> {
+        if !value.is_finite() {
+            return Err(Error::invalid_value(name, value, "not a finite number"));
+        }
+        let reason = match key {
+            FixedKey::YoungsModulus if value <= 0.0 => Some("must be positive"),
+            FixedKey::Density if value <= 0.0 => Some("must be positive"),
+            FixedKey::PoissonRatio if !(value > -1.0 && value < 0.5) => {
+                Some("must lie in (-1, 0.5): 0.5 is incompressible, which a displacement formulation cannot represent")
+            }
+            FixedKey::DampingAlpha | FixedKey::DampingBeta if value < 0.0 => {
+                Some("must not be negative (negative damping adds energy)")
+            }
+            FixedKey::StepSize if value <= 0.0 => Some("must be positive"),
+            FixedKey::RhoInf if !(0.0..=1.0).contains(&value) => Some("must lie in [0, 1]"),
+            FixedKey::Tolerance if !(value > 0.0 && value < 1.0) => Some("must lie in (0, 1)"),
+            _ => None,
+        };
+        match reason {
+            Some(r) => Err(Error::invalid_value(name, value, r)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// An interface at run time: its kind and node set.
 #[derive(Debug, Clone)]
-pub struct SlaveState {}
+struct Interface {
+    kind: InterfaceKind,
+    set: NodeSet,
+}
+
+/// The assembled model for one set of parameters.
+struct Model {
+    key: (IsotropicMaterial, [u64; 4], bool),
+    body: Body,
+    free: FreeNodes,
+    scheme: GeneralizedAlpha,
+    matrices: Vec<IterationMatrix>,
+    workspace: StepWorkspace,
+}
+
+/// The motion state and the loads it is in equilibrium with.
+#[derive(Debug, Clone, PartialEq)]
+struct Dynamics {
+    state: DynamicState,
+    /// Force and torque inputs per interface that `state`'s accelerations belong to.
+    loads: Vec<[f64; 6]>,
+    gravity: [f64; 3],
+}
+
+/// A snapshot of everything that determines later steps (time, positions, velocities,
+/// accelerations, inputs, parameters). Restoring it reproduces later steps bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlaveState {
+    parameters: Parameters,
+    inputs: Vec<[f64; 6]>,
+    start_time: f64,
+    dynamics: Option<Dynamics>,
+}
+
+/// Outputs computed once per state, on the first read.
+#[derive(Debug, Clone, Default)]
+struct Outputs {
+    valid: bool,
+    body: [f64; 26],
+    /// Per interface: force[3], torque[3], then motion (position, rotation, velocity, angular
+    /// velocity, acceleration, angular acceleration) in value-reference slot order.
+    interfaces: Vec<[f64; 30]>,
+}
 
 /// One instance of the flexible body.
 pub struct Slave {
     body_file: BodyFile,
     variables: VariableTable,
     guid: String,
+    mesh: Mesh,
+    /// Node sets, and `clamped[i]` for nodes held by a `fixed` support.
+    interfaces: Vec<Interface>,
+    clamped: Vec<bool>,
+    /// Characteristic size of the body (m): the diagonal of its bounding box.
+    size: f64,
+    defaults: Parameters,
+    parameters: Parameters,
+    inputs: Vec<[f64; 6]>,
+    start_time: f64,
+    model: Option<Model>,
+    dynamics: Option<Dynamics>,
+    /// Backup of the dynamics at the start of a communication step (rollback on failure).
+    backup: Option<DynamicState>,
+    outputs: Outputs,
 }
 
 impl Slave {
     /// Loads `body.json` from the resource directory if there is one, else the embedded default body.
     pub fn from_resources(resource_dir: Option<&Path>) -> Result<Slave> {
-        let _ = resource_dir;
-        todo!()
+        let body = match resource_dir.map(|d| d.join("body.json")) {
+            Some(path) if path.exists() => {
+                let text = std::fs::read_to_string(&path).map_err(|e| {
+                    Error::new(format!("cannot read the body file {}: {e}", path.display()))
+                })?;
+                BodyFile::from_json(&text)
+                    .map_err(|e| Error::new(format!("{}: {}", path.display(), e.message)))?
+            }
+            _ => BodyFile::default_body(),
+        };
+        Slave::from_body(body)
     }
 
     /// A fresh instance of `body_file` (parameters at their start values, Instantiated).
     pub fn from_body(body_file: BodyFile) -> Result<Slave> {
-        let _ = body_file;
-        todo!()
+        body_file.check()?;
+        let mesh = match &body_file.mesh {
+            MeshSpec::Beam {
+                length,
+                width,
+                height,
+                divisions,
+                element,
+            } => mesh::beam(*length, *width, *height, *divisions, *element)?,
+        };
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let lumped = fem::lumped_masses(&mesh, 1.0);
+        let mut interfaces = Vec::new();
+        let mut clamped = vec![false; mesh.node_count()];
+        for spec in &body_file.interfaces {
+            let nodes = spec
+                .nodes
+                .select(&mesh)
+                .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
+            let weights = nodes.iter().map(|&i| lumped[i]).collect();
+            if spec.kind == InterfaceKind::Fixed {
+                for &i in &nodes {
+                    clamped[i] = true;
+                }
+            }
+            let set = NodeSet::new(
+                &spec.name,
+                nodes,
+                weights,
+                &reference,
+                spec.reference_point.map(Vector3::from),
+            )?;
+            interfaces.push(Interface {
+                kind: spec.kind,
+                set,
+            });
+        }
+        if clamped.iter().all(|&c| c) {
+            return Err(Error::new("body file: fixed supports hold every node: nothing can move"));
+        }
+        let (lo, hi) = mesh.bounding_box();
+        let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
+        let variables = VariableTable::new(&body_file.interfaces);
+        let defaults = Parameters::from_body_file(&body_file);
+        for v in variables.iter() {
+            if let (Target::Fixed { key, .. }, VariableType::Real) = (v.target, v.ty) {
+                let value = read_parameter(&defaults, key, component_of(v));
+                if let Some(value) = value {
+                    Parameters::check_real(&v.name, key, value)
+                        .map_err(|e| Error::new(format!("body file: {}", e.message)))?;
+                }
+            }
+        }
+        let guid = guid_of(&body_file);
+        let n_interfaces = interfaces.len();
+        Ok(Slave {
+            body_file,
+            variables,
+            guid,
+            mesh,
+            interfaces,
+            clamped,
+            size,
+            parameters: defaults.clone(),
+            defaults,
+            inputs: vec![[0.0; 6]; n_interfaces],
+            start_time: 0.0,
+            model: None,
+            dynamics: None,
+            backup: None,
+            outputs: Outputs {
+                interfaces: vec![[0.0; 30]; n_interfaces],
+                ..Outputs::default()
+            },
+        })
     }
 
     /// The GUID of this body (fixed variable table, crate version and body file).
@@ -41,91 +278,685 @@ impl Slave {
         &self.body_file
     }
 
+    /// The mesh of the body.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
     /// The variable table (value references, causality, variability).
     pub fn variables(&self) -> &VariableTable {
         &self.variables
     }
 
-    /// `fmi2SetupExperiment`: start time; stop time and tolerance are optional.
-    pub fn setup_experiment(&mut self, start_time: f64, stop_time: Option<f64>, tolerance: Option<f64>) -> Result<()> {
-        let _ = (start_time, stop_time, tolerance);
-        todo!()
+    /// The current parameter values.
+    pub fn parameters(&self) -> &Parameters {
+        &self.parameters
+    }
+
+    /// `fmi2SetupExperiment`: start time; stop time and tolerance are optional (and not needed).
+    pub fn setup_experiment(
+        &mut self,
+        start_time: f64,
+        stop_time: Option<f64>,
+        tolerance: Option<f64>,
+    ) -> Result<()> {
+        if !start_time.is_finite() {
+            return Err(Error::invalid_value("startTime", start_time, "not a finite number"));
+        }
+        if let Some(stop) = stop_time {
+            if !(stop >= start_time) {
+                return Err(Error::invalid_value(
+                    "stopTime",
+                    stop,
+                    "must not be before startTime",
+                ));
+            }
+        }
+        let _ = tolerance; // the body's own solver.tolerance governs the iteration
+        self.start_time = start_time;
+        Ok(())
     }
 
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
-        todo!()
+        self.dynamics = None;
+        self.outputs.valid = false;
+        Ok(())
     }
 
-    /// `fmi2ExitInitializationMode`: validates the parameters, assembles and places the body.
+    /// `fmi2ExitInitializationMode`: validates the parameters, assembles and places the body,
+    /// factorises the iteration matrix for `solver.stepSize`.
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
-        todo!()
-    }
-
-    /// Value of a Real variable (the value reference is known to the table).
-    pub fn get_real(&mut self, vr: u32) -> Result<f64> {
-        let _ = vr;
-        todo!()
-    }
-
-    /// Sets a Real parameter or input; rejects NaN, infinities and out-of-range values with a
-    /// message naming the variable. The caller has checked that the variable may be set now.
-    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
-        let _ = (vr, value);
-        todo!()
-    }
-
-    pub fn get_integer(&mut self, vr: u32) -> Result<i32> {
-        let _ = vr;
-        todo!()
-    }
-
-    pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
-        let _ = (vr, value);
-        todo!()
-    }
-
-    pub fn get_boolean(&mut self, vr: u32) -> Result<bool> {
-        let _ = vr;
-        todo!()
-    }
-
-    pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
-        let _ = (vr, value);
-        todo!()
-    }
-
-    /// `fmi2DoStep`: advances from `current_communication_point` (must match the internal time
-    /// within a relative 1e-5 of the step) by `communication_step_size` > 0. On error the state is
-    /// unchanged; a step that does not converge is an `ErrorKind::Discard`.
-    pub fn do_step(&mut self, current_communication_point: f64, communication_step_size: f64) -> Result<()> {
-        let _ = (current_communication_point, communication_step_size);
-        todo!()
+        self.ensure_initial_state()?;
+        let h = self.parameters.step_size;
+        self.matrix_index(h)?;
+        Ok(())
     }
 
     /// Current simulation time (s): the last successful communication point.
     pub fn time(&self) -> f64 {
-        todo!()
+        self.dynamics
+            .as_ref()
+            .map_or(self.start_time, |d| d.state.time)
     }
 
-    /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values).
+    /// Positions, velocities and accelerations (flat `3N`) once initialized.
+    pub fn dynamic_state(&self) -> Option<&DynamicState> {
+        self.dynamics.as_ref().map(|d| &d.state)
+    }
+
+    /// The assembled body once initialized.
+    pub fn body(&self) -> Option<&Body> {
+        self.model.as_ref().map(|m| &m.body)
+    }
+
+    /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values). The
+    /// assembled matrices are kept for reuse if the parameters come back the same.
     pub fn reset(&mut self) {
-        todo!()
+        self.parameters = self.defaults.clone();
+        self.inputs.iter_mut().for_each(|i| *i = [0.0; 6]);
+        self.start_time = 0.0;
+        self.dynamics = None;
+        self.backup = None;
+        self.outputs.valid = false;
     }
 
     /// `fmi2GetFMUstate`.
     pub fn get_state(&self) -> SlaveState {
-        todo!()
+        SlaveState {
+            parameters: self.parameters.clone(),
+            inputs: self.inputs.clone(),
+            start_time: self.start_time,
+            dynamics: self.dynamics.clone(),
+        }
     }
 
     /// `fmi2SetFMUstate`.
     pub fn set_state(&mut self, state: &SlaveState) -> Result<()> {
-        let _ = state;
-        todo!()
+        if state.inputs.len() != self.inputs.len() {
+            return Err(Error::new("the FMU state belongs to another body"));
+        }
+        self.parameters = state.parameters.clone();
+        self.inputs.clone_from(&state.inputs);
+        self.start_time = state.start_time;
+        if state.dynamics.is_some() {
+            self.ensure_model()?;
+        }
+        match (&mut self.dynamics, &state.dynamics) {
+            (Some(d), Some(s)) if d.state.position.len() == s.state.position.len() => {
+                d.state.copy_from(&s.state);
+                d.loads.clone_from(&s.loads);
+                d.gravity = s.gravity;
+            }
+            (d, s) => *d = s.clone(),
+        }
+        self.outputs.valid = false;
+        Ok(())
     }
 
     /// The complete `modelDescription.xml` of this body.
     pub fn model_description(&self) -> String {
-        todo!()
+        let info = ModelInfo {
+            model_name: self.body_file.name.clone(),
+            description: self.body_file.description.clone(),
+            guid: self.guid.clone(),
+            generation_tool: format!("flexbody {}", env!("CARGO_PKG_VERSION")),
+            default_step_size: self.defaults.step_size,
+        };
+        model_description(&self.variables, &info, &|v: &Variable| self.start_value(v))
     }
+
+    /// Start value of a parameter or input as written in the XML (full precision).
+    fn start_value(&self, v: &Variable) -> String {
+        match (v.ty, v.target) {
+            (VariableType::Boolean, Target::Fixed { key, .. }) => {
+                read_boolean(&self.defaults, key).unwrap_or(false).to_string()
+            }
+            (VariableType::Integer, Target::Fixed { key, .. }) => {
+                read_integer(&self.defaults, key).unwrap_or(0).to_string()
+            }
+            (VariableType::Real, Target::Fixed { key, component }) => {
+                format!("{:?}", read_parameter(&self.defaults, key, component).unwrap_or(0.0))
+            }
+            _ => "0.0".to_string(),
+        }
+    }
+
+    fn lookup(&self, ty: VariableType, vr: u32) -> Result<Variable> {
+        self.variables
+            .get(ty, vr)
+            .cloned()
+            .ok_or_else(|| Error::new(format!("no {ty:?} variable has value reference {vr}")))
+    }
+
+    /// Value of a Real variable.
+    pub fn get_real(&mut self, vr: u32) -> Result<f64> {
+        let (target, causality) = match self.variables.get(VariableType::Real, vr) {
+            Some(v) => (v.target, v.causality),
+            None => return Err(Error::new(format!("no Real variable has value reference {vr}"))),
+        };
+        let value = match target {
+            Target::Fixed { key, component } => match read_parameter(&self.parameters, key, component) {
+                Some(p) => p,
+                None => {
+                    self.ensure_outputs()?;
+                    self.outputs.body[body_output_slot(key) + component]
+                }
+            },
+            Target::Interface {
+                index,
+                quantity,
+                component,
+            } => {
+                if causality == crate::model::Causality::Input {
+                    self.inputs[index][quantity.slot() as usize + component]
+                } else {
+                    self.ensure_outputs()?;
+                    self.outputs.interfaces[index][quantity.slot() as usize + component]
+                }
+            }
+        };
+        // Never hand out a NaN: the state is checked after every step, so this is a guard.
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(Error::new(format!(
+                "value reference {vr} evaluated to {value}: the state is not finite"
+            )))
+        }
+    }
+
+    /// Sets a Real parameter or input; rejects NaN, infinities and out-of-range values with a
+    /// message naming the variable; a rejected value changes nothing.
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
+        let v = self.lookup(VariableType::Real, vr)?;
+        match v.target {
+            Target::Fixed { key, component } => {
+                Parameters::check_real(&v.name, key, value)?;
+                let p = write_parameter(&mut self.parameters, key, component).ok_or_else(|| {
+                    Error::new(format!("{} is an output and cannot be set", v.name))
+                })?;
+                *p = value;
+            }
+            Target::Interface {
+                index,
+                quantity,
+                component,
+            } => {
+                if !value.is_finite() {
+                    return Err(Error::invalid_value(&v.name, value, "not a finite number"));
+                }
+                if !matches!(quantity, InterfaceQuantity::Force | InterfaceQuantity::Torque)
+                    || self.interfaces[index].kind != InterfaceKind::Force
+                {
+                    return Err(Error::new(format!("{} is an output and cannot be set", v.name)));
+                }
+                self.inputs[index][quantity.slot() as usize + component] = value;
+            }
+        }
+        Ok(())
+    }
+
+    pub fn get_integer(&mut self, vr: u32) -> Result<i32> {
+        let v = self.lookup(VariableType::Integer, vr)?;
+        match v.target {
+            Target::Fixed { key, .. } => read_integer(&self.parameters, key),
+            _ => None,
+        }
+        .ok_or_else(|| Error::new(format!("no Integer variable has value reference {vr}")))
+    }
+
+    pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
+        let v = self.lookup(VariableType::Integer, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::MaxIterations,
+                ..
+            } => {
+                if value < 1 {
+                    return Err(Error::invalid_value(&v.name, value, "must be at least 1"));
+                }
+                self.parameters.max_iterations = value;
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    pub fn get_boolean(&mut self, vr: u32) -> Result<bool> {
+        let v = self.lookup(VariableType::Boolean, vr)?;
+        match v.target {
+            Target::Fixed { key, .. } => read_boolean(&self.parameters, key),
+            _ => None,
+        }
+        .ok_or_else(|| Error::new(format!("no Boolean variable has value reference {vr}")))
+    }
+
+    pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
+        let v = self.lookup(VariableType::Boolean, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::NonlinearForces,
+                ..
+            } => {
+                self.parameters.nonlinear_forces = value;
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    /// `fmi2DoStep`: advances from `current_communication_point` (must match the internal time
+    /// within a relative 1e-5 of the step) by `communication_step_size` > 0, in equal internal
+    /// steps no longer than `solver.stepSize`. On error the state is unchanged; a step that does
+    /// not converge is an [`ErrorKind::Discard`].
+    pub fn do_step(
+        &mut self,
+        current_communication_point: f64,
+        communication_step_size: f64,
+    ) -> Result<()> {
+        let big_h = communication_step_size;
+        if !(big_h.is_finite() && big_h > 0.0) {
+            return Err(Error::invalid_value(
+                "communicationStepSize",
+                big_h,
+                "must be positive and finite",
+            ));
+        }
+        let t = self.time();
+        if self.dynamics.is_none() {
+            return Err(Error::new("doStep before the body was initialized"));
+        }
+        let slack = 1e-5 * big_h + 4.0 * f64::EPSILON * t.abs();
+        if !current_communication_point.is_finite()
+            || (current_communication_point - t).abs() > slack
+        {
+            return Err(Error::invalid_value(
+                "currentCommunicationPoint",
+                current_communication_point,
+                &format!("does not match the FMU's time {t} (restore a state with fmi2SetFMUstate to go back)"),
+            ));
+        }
+        let substeps = ((big_h / self.parameters.step_size) * (1.0 - 1e-9)).ceil().max(1.0);
+        if substeps > 1e9 {
+            return Err(Error::invalid_value(
+                "communicationStepSize",
+                big_h,
+                "needs more than 1e9 internal steps of solver.stepSize",
+            ));
+        }
+        let h = big_h / substeps;
+        let index = self.matrix_index(h)?;
+        let settings = IterationSettings {
+            absolute_tolerance: self.parameters.tolerance * self.size,
+            max_iterations: self.parameters.max_iterations.max(1) as usize,
+        };
+        let model = self.model.as_mut().expect("matrix_index built the model");
+        let dynamics = self.dynamics.as_mut().unwrap();
+        let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
+        backup.copy_from(&dynamics.state);
+        dynamics.state.time = current_communication_point;
+        let gravity = Vector3::from(self.parameters.gravity);
+        let interfaces = &self.interfaces;
+        let inputs = &self.inputs;
+        let body = &model.body;
+        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        let mut result = Ok(());
+        for _ in 0..substeps as usize {
+            let r = generalized_alpha::step(
+                body,
+                &model.free,
+                &model.scheme,
+                &mut model.matrices[index],
+                &settings,
+                &loads,
+                h,
+                &mut dynamics.state,
+                &mut model.workspace,
+            );
+            if let Err(e) = r {
+                result = Err(e);
+                break;
+            }
+        }
+        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
+            result = Err(Error::discard("the step produced non-finite positions"));
+        }
+        match result {
+            Ok(()) => {
+                dynamics.state.time = current_communication_point + big_h;
+                dynamics.loads.clone_from(&self.inputs);
+                dynamics.gravity = self.parameters.gravity;
+                self.outputs.valid = false;
+                Ok(())
+            }
+            Err(e) => {
+                dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                let kind = e.kind;
+                let message = format!(
+                    "doStep from t = {current_communication_point} by {big_h}: {}; the state was rolled back to t = {current_communication_point}",
+                    e.message
+                );
+                Err(Error {
+                    kind: if kind == ErrorKind::Discard { ErrorKind::Discard } else { ErrorKind::Error },
+                    message,
+                })
+            }
+        }
+    }
+
+    /// Builds the model if the parameters it depends on changed (assembly and frames).
+    fn ensure_model(&mut self) -> Result<()> {
+        let key = self.parameters.model_key();
+        if self.model.as_ref().is_some_and(|m| m.key == key) {
+            return Ok(());
+        }
+        let p = &self.parameters;
+        p.material.validate()?;
+        let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
+        let body = Body::new(
+            reference,
+            fem::scalar_mass_matrix(&self.mesh, p.material.density),
+            fem::stiffness_matrix(&self.mesh, &p.material),
+            fem::lumped_masses(&self.mesh, p.material.density),
+            BodyOptions {
+                nonlinear_forces: p.nonlinear_forces,
+                damping_alpha: p.damping_alpha,
+                damping_beta: p.damping_beta,
+            },
+        );
+        let free = FreeNodes::new(&body, &self.clamped);
+        let workspace = StepWorkspace::new(&body, &free);
+        self.model = Some(Model {
+            key,
+            body,
+            free,
+            scheme: GeneralizedAlpha::new(p.rho_inf),
+            matrices: Vec::new(),
+            workspace,
+        });
+        self.dynamics = None;
+        Ok(())
+    }
+
+    /// Index of the factorization for internal step `h` in the cache (factorising on a miss).
+    fn matrix_index(&mut self, h: f64) -> Result<usize> {
+        self.ensure_model()?;
+        let p = &self.parameters;
+        let model = self.model.as_mut().unwrap();
+        if let Some(i) = model
+            .matrices
+            .iter()
+            .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
+        {
+            return Ok(i);
+        }
+        let matrix = IterationMatrix::new(
+            &model.free,
+            &model.scheme,
+            h,
+            p.damping_alpha,
+            p.damping_beta,
+        )?;
+        if model.matrices.len() >= MATRIX_CACHE_SIZE {
+            model.matrices.remove(0);
+        }
+        model.matrices.push(matrix);
+        Ok(model.matrices.len() - 1)
+    }
+
+    /// Places the body rigidly at the initial pose with the initial velocity and computes the
+    /// consistent initial acceleration, unless that was done for the current parameters.
+    fn ensure_initial_state(&mut self) -> Result<()> {
+        self.ensure_model()?;
+        let p = &self.parameters;
+        let q = Matrix3::from_row_slice(&p.initial_rotation);
+        let deviation = (q.transpose() * q - Matrix3::identity()).amax();
+        if deviation > 1e-6 || q.determinant() <= 0.0 {
+            return Err(Error::new(format!(
+                "initial.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6})",
+                p.initial_rotation,
+                q.determinant()
+            )));
+        }
+        let q = nearest_rotation(&q);
+        let v0 = Vector3::from(p.initial_velocity);
+        let w0 = Vector3::from(p.initial_angular_velocity);
+        if self.clamped.iter().any(|&c| c) && (v0.norm() > 0.0 || w0.norm() > 0.0) {
+            return Err(Error::new(format!(
+                "initial.velocity = {:?} and initial.angularVelocity = {:?} rejected: a body held by a fixed support must start at rest",
+                p.initial_velocity, p.initial_angular_velocity
+            )));
+        }
+        let p0 = Vector3::from(p.initial_position);
+        let model = self.model.as_mut().unwrap();
+        let body = &model.body;
+        let n = body.node_count();
+        let mut state = DynamicState {
+            time: self.start_time,
+            position: vec![0.0; 3 * n],
+            velocity: vec![0.0; 3 * n],
+            acceleration: vec![0.0; 3 * n],
+            pseudo_acceleration: vec![0.0; 3 * n],
+        };
+        for i in 0..n {
+            let r = q * node(&body.reference, i);
+            set_node(&mut state.position, i, &(p0 + r));
+            if !self.clamped[i] {
+                set_node(&mut state.velocity, i, &(v0 + w0.cross(&r)));
+            }
+        }
+        let gravity = Vector3::from(p.gravity);
+        let interfaces = &self.interfaces;
+        let inputs = &self.inputs;
+        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        generalized_alpha::initial_acceleration(body, &model.free, &loads, &mut state, &mut model.workspace)?;
+        self.dynamics = Some(Dynamics {
+            state,
+            loads: self.inputs.clone(),
+            gravity: p.gravity,
+        });
+        self.outputs.valid = false;
+        Ok(())
+    }
+
+    /// Computes the outputs of the current state (once per state).
+    fn ensure_outputs(&mut self) -> Result<()> {
+        if self.outputs.valid {
+            return Ok(());
+        }
+        if self.dynamics.is_none() {
+            // Initialization mode: outputs of the rigidly placed body with the current inputs.
+            self.ensure_initial_state()?;
+        }
+        let model = self.model.as_mut().unwrap();
+        let dynamics = self.dynamics.as_ref().unwrap();
+        let state = &dynamics.state;
+        let body = &model.body;
+        let gravity = Vector3::from(dynamics.gravity);
+        let interfaces = &self.interfaces;
+        let loads_in = &dynamics.loads;
+        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, loads_in, &gravity, x, f);
+        let kin = generalized_alpha::residual(body, state, &loads, &mut model.workspace);
+        let residual = generalized_alpha::last_residual(&model.workspace);
+
+        // Body outputs (DESIGN.md section 4).
+        let m = body.total_mass;
+        let (mut com, mut vcom) = (Vector3::zeros(), Vector3::zeros());
+        for (i, &mi) in body.mass_row_sums.iter().enumerate() {
+            com += mi * node(&state.position, i);
+            vcom += mi * node(&state.velocity, i);
+        }
+        com /= m;
+        vcom /= m;
+        let (mut angular, mut kinetic) = (Vector3::zeros(), 0.0);
+        let ms = &body.mass_matrix;
+        for i in 0..ms.n {
+            let mut mv = Vector3::zeros();
+            for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
+                mv += ms.values[k] * node(&state.velocity, ms.col_idx[k]);
+            }
+            angular += (node(&state.position, i) - com).cross(&mv);
+            kinetic += 0.5 * node(&state.velocity, i).dot(&mv);
+        }
+        let r = kin.frame.rotation;
+        let omega = r * kin.angular_velocity_body;
+        let out = &mut self.outputs.body;
+        out[0..3].copy_from_slice(com.as_slice());
+        for (k, value) in out[3..12].iter_mut().enumerate() {
+            *value = r[(k / 3, k % 3)];
+        }
+        out[12..15].copy_from_slice(vcom.as_slice());
+        out[15..18].copy_from_slice(omega.as_slice());
+        out[18..21].copy_from_slice((m * vcom).as_slice());
+        out[21..24].copy_from_slice(angular.as_slice());
+        out[24] = kinetic;
+        out[25] = kin.strain_energy;
+
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            let out = &mut self.outputs.interfaces[k];
+            match interface.kind {
+                InterfaceKind::Fixed => {
+                    // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
+                    let (f, t) = interface.set.resultant(&state.position, residual);
+                    out[0..3].copy_from_slice(f.as_slice());
+                    out[3..6].copy_from_slice(t.as_slice());
+                }
+                InterfaceKind::Force => {
+                    out[0..6].copy_from_slice(&dynamics.loads[k]);
+                    let m: InterfaceMotion = interface.set.motion(
+                        &state.position,
+                        &state.velocity,
+                        &state.acceleration,
+                    );
+                    out[6..9].copy_from_slice(m.position.as_slice());
+                    for (j, value) in out[9..18].iter_mut().enumerate() {
+                        *value = m.rotation[(j / 3, j % 3)];
+                    }
+                    out[18..21].copy_from_slice(m.velocity.as_slice());
+                    out[21..24].copy_from_slice(m.angular_velocity.as_slice());
+                    out[24..27].copy_from_slice(m.acceleration.as_slice());
+                    out[27..30].copy_from_slice(m.angular_acceleration.as_slice());
+                }
+            }
+        }
+        let finite = self.outputs.body.iter().all(|x| x.is_finite())
+            && self.outputs.interfaces.iter().flatten().all(|x| x.is_finite());
+        if !finite {
+            return Err(Error::new("the outputs of the current state are not finite"));
+        }
+        self.outputs.valid = true;
+        Ok(())
+    }
+}
+
+/// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
+/// torque distributed over its node set; added to `f`.
+fn apply_loads(
+    body: &Body,
+    interfaces: &[Interface],
+    inputs: &[[f64; 6]],
+    gravity: &Vector3<f64>,
+    x: &[f64],
+    f: &mut [f64],
+) {
+    if gravity.norm_squared() > 0.0 {
+        body.add_uniform_acceleration_load(gravity, f);
+    }
+    for (interface, load) in interfaces.iter().zip(inputs) {
+        if interface.kind == InterfaceKind::Force && load.iter().any(|&v| v != 0.0) {
+            let force = Vector3::new(load[0], load[1], load[2]);
+            let torque = Vector3::new(load[3], load[4], load[5]);
+            interface.set.distribute(x, &force, &torque, f);
+        }
+    }
+}
+
+fn component_of(v: &Variable) -> usize {
+    match v.target {
+        Target::Fixed { component, .. } | Target::Interface { component, .. } => component,
+    }
+}
+
+/// Offset of a body output in [`Outputs::body`].
+fn body_output_slot(key: FixedKey) -> usize {
+    match key {
+        FixedKey::BodyPosition => 0,
+        FixedKey::BodyRotation => 3,
+        FixedKey::BodyVelocity => 12,
+        FixedKey::BodyAngularVelocity => 15,
+        FixedKey::BodyLinearMomentum => 18,
+        FixedKey::BodyAngularMomentum => 21,
+        FixedKey::BodyKineticEnergy => 24,
+        FixedKey::BodyStrainEnergy => 25,
+        _ => unreachable!("{key:?} is not a body output"),
+    }
+}
+
+/// Value of a Real parameter (`None` for outputs and non-Real keys).
+fn read_parameter(p: &Parameters, key: FixedKey, c: usize) -> Option<f64> {
+    let mut copy = p.clone();
+    write_parameter(&mut copy, key, c).map(|v| *v)
+}
+
+/// The storage of a Real parameter (`None` for outputs and non-Real keys).
+fn write_parameter(p: &mut Parameters, key: FixedKey, c: usize) -> Option<&mut f64> {
+    use FixedKey::*;
+    Some(match key {
+        YoungsModulus => &mut p.material.youngs_modulus,
+        PoissonRatio => &mut p.material.poisson_ratio,
+        Density => &mut p.material.density,
+        DampingAlpha => &mut p.damping_alpha,
+        DampingBeta => &mut p.damping_beta,
+        Gravity => &mut p.gravity[c],
+        InitialPosition => &mut p.initial_position[c],
+        InitialRotation => &mut p.initial_rotation[c],
+        InitialVelocity => &mut p.initial_velocity[c],
+        InitialAngularVelocity => &mut p.initial_angular_velocity[c],
+        StepSize => &mut p.step_size,
+        RhoInf => &mut p.rho_inf,
+        Tolerance => &mut p.tolerance,
+        _ => return None,
+    })
+}
+
+fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
+    match key {
+        FixedKey::MaxIterations => Some(p.max_iterations),
+        _ => None,
+    }
+}
+
+fn read_boolean(p: &Parameters, key: FixedKey) -> Option<bool> {
+    match key {
+        FixedKey::NonlinearForces => Some(p.nonlinear_forces),
+        _ => None,
+    }
+}
+
+/// GUID of a body: FNV-1a (two seeds) of the fixed table's fingerprint, the crate version and the
+/// canonical body file, formatted as a UUID.
+pub fn guid_of(body_file: &BodyFile) -> String {
+    let text = format!(
+        "{FIXED_TABLE_FINGERPRINT:x}|{}|{}",
+        env!("CARGO_PKG_VERSION"),
+        body_file.to_canonical_json()
+    );
+    let fnv = |seed: u64| {
+        let mut h = seed;
+        for b in text.bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x100000001b3);
+        }
+        h
+    };
+    let (a, b) = (fnv(0xcbf29ce484222325), fnv(0x84222325cbf29ce4));
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
 }

@@ -1,2 +1,252 @@
-//! The ACF-RS body (DESIGN.md section 2): co-moving frame, local deformation, internal force with
-//! the nonlinear term `f_nl`, damping, interfaces.
+//! The ACF-RS body (DESIGN.md section 2): constant mass `M = Ms ⊗ I3`, constant small-strain
+//! stiffness `K`, the co-moving frame, the local deformation `ū`, the internal force with the
+//! nonlinear term `f_nl`, Rayleigh damping of the deformation, and the node sets of interfaces.
+
+pub mod frame;
+pub mod interface;
+
+pub use frame::{Frame, FrameWeights};
+pub use interface::NodeSet;
+
+use crate::fem::SymmetricCsr;
+use frame::{add_node, node, set_node};
+use nalgebra::{Matrix3, Vector3};
+
+/// Switches and coefficients of the internal force.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyOptions {
+    /// Include `f_nl` (exact gradient of the strain energy; momentum-conserving). Default off:
+    /// DESIGN.md section 2 keeps it off until the benchmark table says otherwise.
+    pub nonlinear_forces: bool,
+    /// Mass-proportional Rayleigh coefficient `α` (1/s).
+    pub damping_alpha: f64,
+    /// Stiffness-proportional Rayleigh coefficient `β` (s).
+    pub damping_beta: f64,
+}
+
+impl Default for BodyOptions {
+    fn default() -> Self {
+        BodyOptions {
+            nonlinear_forces: false,
+            damping_alpha: 0.0,
+            damping_beta: 0.0,
+        }
+    }
+}
+
+/// The constant data of one elastic body.
+#[derive(Debug, Clone)]
+pub struct Body {
+    /// Reference positions `X`, flat `3N` (m).
+    pub reference: Vec<f64>,
+    /// Consistent scalar mass matrix `Ms` (kg), `N × N`; `M = Ms ⊗ I3`.
+    pub mass_matrix: SymmetricCsr,
+    /// Small-strain stiffness `K` (N/m), `3N × 3N`.
+    pub stiffness_matrix: SymmetricCsr,
+    /// Row sums of `Ms` (kg): `M (1 ⊗ a) = (row sums) ⊗ a`, the exact nodal loads of a uniform
+    /// acceleration field and the weights of the centre of mass.
+    pub mass_row_sums: Vec<f64>,
+    /// Total mass `ρV` (kg).
+    pub total_mass: f64,
+    /// The co-moving frame over all nodes with HRZ-lumped masses as weights.
+    pub frame_weights: FrameWeights,
+    pub options: BodyOptions,
+}
+
+/// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
+/// strain energy.
+#[derive(Debug, Clone, Copy)]
+pub struct BodyKinematics {
+    pub frame: Frame,
+    /// Angular velocity of the co-moving frame in body axes `ω̄` (rad/s).
+    pub angular_velocity_body: Vector3<f64>,
+    /// `V = ½ ūᵀ K ū` (J).
+    pub strain_energy: f64,
+}
+
+/// Scratch vectors of [`Body::internal_force`] (allocate once with [`Body::force_scratch`]).
+#[derive(Debug, Clone)]
+pub struct ForceScratch {
+    local_deformation: Vec<f64>,
+    elastic_force: Vec<f64>,
+    deformation_rate: Vec<f64>,
+    damping_force: Vec<f64>,
+    mass_times: Vec<f64>,
+}
+
+impl Body {
+    /// A body from its constant matrices; `lumped_masses` (positive) weight the co-moving frame.
+    pub fn new(
+        reference: Vec<f64>,
+        mass_matrix: SymmetricCsr,
+        stiffness_matrix: SymmetricCsr,
+        lumped_masses: Vec<f64>,
+        options: BodyOptions,
+    ) -> Body {
+        let n = reference.len() / 3;
+        assert_eq!(mass_matrix.n, n);
+        assert_eq!(stiffness_matrix.n, 3 * n);
+        let ones = vec![1.0; n];
+        let mut mass_row_sums = vec![0.0; n];
+        mass_matrix.mul_vec(&ones, &mut mass_row_sums);
+        let total_mass = mass_row_sums.iter().sum();
+        let frame_weights = FrameWeights::new((0..n).collect(), lumped_masses, &reference);
+        Body {
+            reference,
+            mass_matrix,
+            stiffness_matrix,
+            mass_row_sums,
+            total_mass,
+            frame_weights,
+            options,
+        }
+    }
+
+    /// Number of nodes `N`.
+    pub fn node_count(&self) -> usize {
+        self.reference.len() / 3
+    }
+
+    /// Scratch for [`Self::internal_force`].
+    pub fn force_scratch(&self) -> ForceScratch {
+        let n3 = self.reference.len();
+        ForceScratch {
+            local_deformation: vec![0.0; n3],
+            elastic_force: vec![0.0; n3],
+            deformation_rate: vec![0.0; n3],
+            damping_force: vec![0.0; n3],
+            mass_times: vec![0.0; n3],
+        }
+    }
+
+    /// `y = M v = (Ms ⊗ I3) v` for a flat `3N` vector (no allocation: `Ms` acts on each
+    /// direction through a strided copy in `scratch`, length `3N`).
+    pub fn mass_times(&self, v: &[f64], y: &mut [f64]) {
+        let ms = &self.mass_matrix;
+        for i in 0..ms.n {
+            let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
+            for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
+                let j = ms.col_idx[k];
+                let m = ms.values[k];
+                a += m * v[3 * j];
+                b += m * v[3 * j + 1];
+                c += m * v[3 * j + 2];
+            }
+            y[3 * i] = a;
+            y[3 * i + 1] = b;
+            y[3 * i + 2] = c;
+        }
+    }
+
+    /// The internal force `f = f_int + f_d` at positions `x` and velocities `v` (flat `3N`, N):
+    ///
+    /// * local deformation `ū_i = Rᵀ(x_i − c) − X̄_i` (DESIGN.md section 2);
+    /// * `g = K ū`, elastic force `R g_i` (= `hR K hRᵀ (x − x_r)`, seed paper eq. 9);
+    /// * if `nonlinear_forces`: `f_nl,i = −w_i R (X̄_i × z)`, `z = H⁻ᵀ m̄`, `m̄ = Σ ū_i × g_i`,
+    ///   `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×`: with it `f_int` is the exact gradient of
+    ///   `V = ½ ūᵀ K ū`;
+    /// * damping `f_d = hR (α Ms⊗I3 + β K) dū/dt`, `dū_i/dt = Rᵀ(ẋ_i − ċ) − ω̄ × (X̄_i + ū_i)`,
+    ///   zero for any rigid motion.
+    pub fn internal_force(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        scratch: &mut ForceScratch,
+        f: &mut [f64],
+    ) -> BodyKinematics {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let r = frame.rotation;
+        let rt = r.transpose();
+        let n = self.node_count();
+        let ubar = &mut scratch.local_deformation;
+        for i in 0..n {
+            let u = rt * (node(x, i) - frame.origin) - fw.reference_offsets[i];
+            set_node(ubar, i, &u);
+        }
+        let g = &mut scratch.elastic_force;
+        self.stiffness_matrix.mul_vec(ubar, g);
+        let strain_energy = 0.5 * dot(ubar, g);
+
+        let h = fw.rotation_sensitivity(&frame, x);
+        let h_inv = h.try_inverse().unwrap_or_else(Matrix3::zeros);
+        let damped = self.options.damping_alpha != 0.0 || self.options.damping_beta != 0.0;
+        let angular_velocity_body = fw.angular_velocity(&frame, &h_inv, v);
+
+        // g ← g + β K dū/dt + α Ms dū/dt, all in the co-moving frame.
+        if damped {
+            let cdot = fw.centroid(v);
+            let rate = &mut scratch.deformation_rate;
+            for i in 0..n {
+                let y = fw.reference_offsets[i] + node(ubar, i);
+                let d = rt * (node(v, i) - cdot) - angular_velocity_body.cross(&y);
+                set_node(rate, i, &d);
+            }
+            let (alpha, beta) = (self.options.damping_alpha, self.options.damping_beta);
+            let fd = &mut scratch.damping_force;
+            if beta != 0.0 {
+                self.stiffness_matrix.mul_vec(rate, fd);
+                for k in 0..fd.len() {
+                    fd[k] *= beta;
+                }
+            } else {
+                fd.fill(0.0);
+            }
+            if alpha != 0.0 {
+                let mt = &mut scratch.mass_times;
+                self.mass_times(rate, mt);
+                for k in 0..fd.len() {
+                    fd[k] += alpha * mt[k];
+                }
+            }
+        }
+
+        // f_nl: z = H⁻ᵀ m̄, m̄ = Σ ū_i × g_i (elastic g only: f_nl is part of ∂V/∂x).
+        let z = if self.options.nonlinear_forces {
+            let mut mbar = Vector3::zeros();
+            for i in 0..n {
+                mbar += node(ubar, i).cross(&node(g, i));
+            }
+            h_inv.transpose() * mbar
+        } else {
+            Vector3::zeros()
+        };
+
+        for i in 0..n {
+            let mut fi = node(g, i);
+            if damped {
+                fi += node(&scratch.damping_force, i);
+            }
+            if self.options.nonlinear_forces {
+                fi -= fw.weights[i] * fw.reference_offsets[i].cross(&z);
+            }
+            set_node(f, i, &(r * fi));
+        }
+        BodyKinematics {
+            frame,
+            angular_velocity_body,
+            strain_energy,
+        }
+    }
+
+    /// Nodal loads of a uniform acceleration field `a` (m/s², e.g. gravity), added to `f`:
+    /// `M (1 ⊗ a)` = row sums of `Ms` times `a` (N).
+    pub fn add_uniform_acceleration_load(&self, a: &Vector3<f64>, f: &mut [f64]) {
+        for (i, &m) in self.mass_row_sums.iter().enumerate() {
+            add_node(f, i, &(m * a));
+        }
+    }
+
+    /// Strain energy `V = ½ ūᵀ K ū` of positions `x` (J); allocates (not for the hot path).
+    pub fn strain_energy(&self, x: &[f64]) -> f64 {
+        let mut scratch = self.force_scratch();
+        let mut f = vec![0.0; x.len()];
+        let zero = vec![0.0; x.len()];
+        self.internal_force(x, &zero, &mut scratch, &mut f).strain_energy
+    }
+}
+
+/// `a · b`.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

@@ -135,7 +135,6 @@ impl InterfaceQuantity {
             (_, AngularVelocity) => "Angular velocity of the node set, power-conjugate to torque",
             (_, Acceleration) => "Acceleration of the reference point",
             (_, AngularAcceleration) => "Angular acceleration of the node set",
-            _ => "",
         }
     }
 }

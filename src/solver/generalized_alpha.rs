@@ -1,1 +1,363 @@
-//! Generalized-α time integration with the constant iteration matrix (DESIGN.md section 3).
+//! Generalized-α time integration (Chung & Hulbert 1993, in the form of Arnold & Brüls 2007) of
+//! `M ẍ + f(x, ẋ) = f_ext(x)` on the free DOFs, with the constant iteration matrix of DESIGN.md
+//! section 3: `S = hR S̄ hRᵀ`, `S̄ = c_m M + c_d D + K`, factorised once per step size.
+//!
+//! Per step, with the pseudo-acceleration `a` (Arnold & Brüls):
+//!
+//! ```text
+//! (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) ẍ_{n+1} + α_f ẍ_n
+//! x_{n+1} = x_n + h ẋ_n + h² (½ − β) a_n + h² β a_{n+1}
+//! ẋ_{n+1} = ẋ_n + h (1 − γ) a_n + h γ a_{n+1}
+//! M ẍ_{n+1} + f(x_{n+1}, ẋ_{n+1}) = f_ext(x_{n+1})          (equilibrium at t_{n+1})
+//! ```
+//!
+//! The unknown is `ẍ_{n+1}`; a correction `Δx` of the positions moves `ẍ` by `c_m Δx` and `ẋ` by
+//! `c_d Δx` with `c_m = (1 − α_m) / ((1 − α_f) β h²)` and `c_d = γ / (β h)`, so the Newton matrix is
+//! `c_m M + c_d D + K_T`. The fixed-point (modified Newton) iteration replaces `K_T` with the
+//! rotated constant `hR K hRᵀ`: each iteration rotates the residual into the co-moving frame, does
+//! one forward and one backward triangular solve with the constant factor of `S̄` and rotates back.
+//! With `ρ∞ = 1` the scheme is the trapezoidal rule (energy-conserving on linear problems).
+
+use super::cholesky::{SolveWorkspace, SparseCholesky};
+use crate::body::frame::{node, set_node};
+use crate::body::{Body, BodyKinematics, ForceScratch};
+use crate::error::{Error, Result};
+use crate::fem::SymmetricCsr;
+
+/// Generalized-α coefficients from the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`:
+/// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`, `β = ¼ (1 − α_m + α_f)²`
+/// (second order, unconditionally stable on linear problems).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GeneralizedAlpha {
+    pub alpha_m: f64,
+    pub alpha_f: f64,
+    pub beta: f64,
+    pub gamma: f64,
+}
+
+impl GeneralizedAlpha {
+    pub fn new(rho_inf: f64) -> GeneralizedAlpha {
+        let alpha_m = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0);
+        let alpha_f = rho_inf / (rho_inf + 1.0);
+        GeneralizedAlpha {
+            alpha_m,
+            alpha_f,
+            gamma: 0.5 - alpha_m + alpha_f,
+            beta: 0.25 * (1.0 - alpha_m + alpha_f).powi(2),
+        }
+    }
+
+    /// `c_m = (1 − α_m) / ((1 − α_f) β h²)` (1/s²): `∂ẍ_{n+1}/∂x_{n+1}`.
+    pub fn mass_coefficient(&self, h: f64) -> f64 {
+        (1.0 - self.alpha_m) / ((1.0 - self.alpha_f) * self.beta * h * h)
+    }
+
+    /// `c_d = γ / (β h)` (1/s): `∂ẋ_{n+1}/∂x_{n+1}`.
+    pub fn damping_coefficient(&self, h: f64) -> f64 {
+        self.gamma / (self.beta * h)
+    }
+}
+
+/// Which nodes move: the others are clamped (a `fixed` support) and keep their positions.
+#[derive(Debug, Clone)]
+pub struct FreeNodes {
+    /// Free node indices, ascending; free node `k` owns rows `3k..3k+3` of the reduced system.
+    pub nodes: Vec<usize>,
+    /// `M ⊗ I3` restricted to the free DOFs.
+    pub mass: SymmetricCsr,
+    /// `K` restricted to the free DOFs.
+    pub stiffness: SymmetricCsr,
+    /// `Ms` restricted to the free nodes (scalar).
+    pub scalar_mass: SymmetricCsr,
+}
+
+impl FreeNodes {
+    /// Free nodes of `body` when `clamped` nodes are held.
+    pub fn new(body: &Body, clamped: &[bool]) -> FreeNodes {
+        let nodes: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
+        let dofs: Vec<usize> = nodes.iter().flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
+        let stiffness = body.stiffness_matrix.submatrix(&dofs);
+        let scalar_mass = body.mass_matrix.submatrix(&nodes);
+        FreeNodes {
+            nodes,
+            mass,
+            stiffness,
+            scalar_mass,
+        }
+    }
+
+    /// Number of free DOFs.
+    pub fn dof_count(&self) -> usize {
+        3 * self.nodes.len()
+    }
+}
+
+/// The factor of `S̄ = c_m M + c_d (α M + β K) + K` on the free DOFs for one step size, with its
+/// solve workspace.
+pub struct IterationMatrix {
+    pub step_size: f64,
+    pub factor: SparseCholesky,
+    workspace: SolveWorkspace,
+}
+
+impl IterationMatrix {
+    /// Assembles and factorises `S̄` for step `h` (the only factorization of a run at this `h`).
+    pub fn new(
+        free: &FreeNodes,
+        scheme: &GeneralizedAlpha,
+        h: f64,
+        damping_alpha: f64,
+        damping_beta: f64,
+    ) -> Result<IterationMatrix> {
+        let c_m = scheme.mass_coefficient(h);
+        let c_d = scheme.damping_coefficient(h);
+        let s = SymmetricCsr::linear_combination(
+            c_m + c_d * damping_alpha,
+            &free.mass,
+            1.0 + c_d * damping_beta,
+            &free.stiffness,
+        );
+        let factor = SparseCholesky::new(&s)?;
+        let workspace = factor.solve_scratch();
+        Ok(IterationMatrix {
+            step_size: h,
+            factor,
+            workspace,
+        })
+    }
+}
+
+/// Positions, velocities, accelerations and pseudo-accelerations (flat `3N`) at `time`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DynamicState {
+    pub time: f64,
+    pub position: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    pub pseudo_acceleration: Vec<f64>,
+}
+
+impl DynamicState {
+    /// Copies `other` into `self` without allocating.
+    pub fn copy_from(&mut self, other: &DynamicState) {
+        self.time = other.time;
+        self.position.copy_from_slice(&other.position);
+        self.velocity.copy_from_slice(&other.velocity);
+        self.acceleration.copy_from_slice(&other.acceleration);
+        self.pseudo_acceleration.copy_from_slice(&other.pseudo_acceleration);
+    }
+}
+
+/// What a step did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    pub iterations: usize,
+    /// Largest position correction of the last iteration (m).
+    pub last_correction: f64,
+}
+
+/// Settings of the fixed-point iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationSettings {
+    /// Converged when the largest position correction is below this (m).
+    pub absolute_tolerance: f64,
+    pub max_iterations: usize,
+}
+
+/// Work vectors of a step (allocated once: a step allocates nothing).
+pub struct StepWorkspace {
+    internal: Vec<f64>,
+    external: Vec<f64>,
+    inertia: Vec<f64>,
+    reduced: Vec<f64>,
+    force_scratch: ForceScratch,
+    previous: DynamicState,
+}
+
+impl StepWorkspace {
+    pub fn new(body: &Body, free: &FreeNodes) -> StepWorkspace {
+        let n3 = body.reference.len();
+        StepWorkspace {
+            internal: vec![0.0; n3],
+            external: vec![0.0; n3],
+            inertia: vec![0.0; n3],
+            reduced: vec![0.0; free.dof_count()],
+            force_scratch: body.force_scratch(),
+            previous: DynamicState {
+                time: 0.0,
+                position: vec![0.0; n3],
+                velocity: vec![0.0; n3],
+                acceleration: vec![0.0; n3],
+                pseudo_acceleration: vec![0.0; n3],
+            },
+        }
+    }
+}
+
+/// The residual `r = M ẍ + f(x, ẋ) − f_ext(x)` (full `3N`, in `ws.internal`), and the body's
+/// kinematics on the way. `loads(x, f_ext)` adds the external loads to a zeroed `f_ext`.
+pub fn residual(
+    body: &Body,
+    state: &DynamicState,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    ws: &mut StepWorkspace,
+) -> BodyKinematics {
+    let kin = body.internal_force(
+        &state.position,
+        &state.velocity,
+        &mut ws.force_scratch,
+        &mut ws.internal,
+    );
+    ws.external.fill(0.0);
+    loads(&state.position, &mut ws.external);
+    body.mass_times(&state.acceleration, &mut ws.inertia);
+    for k in 0..ws.internal.len() {
+        ws.internal[k] += ws.inertia[k] - ws.external[k];
+    }
+    kin
+}
+
+/// The residual left in `ws` by the last [`residual`] call.
+pub fn last_residual(ws: &StepWorkspace) -> &[f64] {
+    &ws.internal
+}
+
+/// One step `t → t + h` of `state`. On failure (no convergence, non-finite values) `state` is
+/// left as it was and the error is an [`crate::ErrorKind::Discard`].
+#[allow(clippy::too_many_arguments)]
+pub fn step(
+    body: &Body,
+    free: &FreeNodes,
+    scheme: &GeneralizedAlpha,
+    matrix: &mut IterationMatrix,
+    settings: &IterationSettings,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    h: f64,
+    state: &mut DynamicState,
+    ws: &mut StepWorkspace,
+) -> Result<StepReport> {
+    ws.previous.copy_from(state);
+    let result = iterate(body, free, scheme, matrix, settings, loads, h, state, ws);
+    if result.is_err() {
+        state.copy_from(&ws.previous);
+    }
+    result
+}
+
+#[allow(clippy::too_many_arguments)]
+fn iterate(
+    body: &Body,
+    free: &FreeNodes,
+    scheme: &GeneralizedAlpha,
+    matrix: &mut IterationMatrix,
+    settings: &IterationSettings,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    h: f64,
+    state: &mut DynamicState,
+    ws: &mut StepWorkspace,
+) -> Result<StepReport> {
+    let GeneralizedAlpha {
+        alpha_m,
+        alpha_f,
+        beta,
+        gamma,
+    } = *scheme;
+    let c_m = scheme.mass_coefficient(h);
+    let c_d = scheme.damping_coefficient(h);
+    let prev = &ws.previous;
+    // Predictor ẍ_{n+1} = ẍ_n, then a, x, ẋ from the update formulas (free nodes only).
+    for &i in &free.nodes {
+        for d in 3 * i..3 * i + 3 {
+            let acc = prev.acceleration[d];
+            let a_new = (alpha_f * prev.acceleration[d] - alpha_m * prev.pseudo_acceleration[d]
+                + (1.0 - alpha_f) * acc)
+                / (1.0 - alpha_m);
+            let a_old = prev.pseudo_acceleration[d];
+            state.acceleration[d] = acc;
+            state.position[d] = prev.position[d]
+                + h * prev.velocity[d]
+                + h * h * ((0.5 - beta) * a_old + beta * a_new);
+            state.velocity[d] = prev.velocity[d] + h * ((1.0 - gamma) * a_old + gamma * a_new);
+        }
+    }
+    state.time = prev.time + h;
+
+    let mut last_correction = f64::INFINITY;
+    for iteration in 1..=settings.max_iterations {
+        let kin = residual(body, state, loads, ws);
+        let r = kin.frame.rotation;
+        let rt = r.transpose();
+        // Rotate the free part of the residual into the co-moving frame, solve, rotate back.
+        for (k, &i) in free.nodes.iter().enumerate() {
+            set_node(&mut ws.reduced, k, &(rt * node(&ws.internal, i)));
+        }
+        matrix
+            .factor
+            .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
+        let mut largest: f64 = 0.0;
+        for (k, &i) in free.nodes.iter().enumerate() {
+            let dx = -(r * node(&ws.reduced, k));
+            for d in 0..3 {
+                let j = 3 * i + d;
+                state.position[j] += dx[d];
+                state.velocity[j] += c_d * dx[d];
+                state.acceleration[j] += c_m * dx[d];
+            }
+            largest = largest.max(dx.amax());
+        }
+        if !largest.is_finite() {
+            return Err(Error::discard(format!(
+                "step to t = {} (h = {h}): the iteration produced a non-finite correction",
+                state.time
+            )));
+        }
+        last_correction = largest;
+        if largest <= settings.absolute_tolerance {
+            let prev = &ws.previous;
+            for &i in &free.nodes {
+                for d in 3 * i..3 * i + 3 {
+                    state.pseudo_acceleration[d] = (alpha_f * prev.acceleration[d]
+                        - alpha_m * prev.pseudo_acceleration[d]
+                        + (1.0 - alpha_f) * state.acceleration[d])
+                        / (1.0 - alpha_m);
+                }
+            }
+            return Ok(StepReport {
+                iterations: iteration,
+                last_correction,
+            });
+        }
+    }
+    Err(Error::discard(format!(
+        "step to t = {} (h = {h}) did not converge in {} iterations (last position correction {last_correction:.3e} m, tolerance {:.3e} m)",
+        state.time, settings.max_iterations, settings.absolute_tolerance
+    )))
+}
+
+/// Consistent initial acceleration on the free DOFs: `M_FF ẍ_F = (f_ext − f(x, ẋ) − M_FC ẍ_C)_F`
+/// with `ẍ_C = 0`; one factorization of `Ms_FF` (at initialization only).
+pub fn initial_acceleration(
+    body: &Body,
+    free: &FreeNodes,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    state: &mut DynamicState,
+    ws: &mut StepWorkspace,
+) -> Result<()> {
+    state.acceleration.fill(0.0);
+    residual(body, state, loads, ws);
+    let factor = SparseCholesky::new(&free.scalar_mass)?;
+    let mut solve_ws = factor.solve_scratch();
+    let mut rhs = vec![0.0; free.nodes.len()];
+    for d in 0..3 {
+        for (k, &i) in free.nodes.iter().enumerate() {
+            rhs[k] = -ws.internal[3 * i + d];
+        }
+        factor.solve_in_place(&mut rhs, &mut solve_ws);
+        for (k, &i) in free.nodes.iter().enumerate() {
+            state.acceleration[3 * i + d] = rhs[k];
+        }
+    }
+    state.pseudo_acceleration.copy_from_slice(&state.acceleration);
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! The co-moving frame `(c, R)` of DESIGN.md section 2: `c = Σ w_i x_i / Σ w_i`, `R` the weighted
+//! best-fit rotation, i.e. the rotation factor of the polar decomposition of
+//! `A = Σ w_i (x_i − c) X̄_iᵀ` with `X̄_i = X_i − X_c`.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// `[a]×`, the cross-product matrix: `[a]× b = a × b`.
+pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
+}
+
+/// Node `i` of a flat `3N` vector.
+#[inline]
+pub fn node(v: &[f64], i: usize) -> Vector3<f64> {
+    Vector3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2])
+}
+
+/// Writes node `i` of a flat `3N` vector.
+#[inline]
+pub fn set_node(v: &mut [f64], i: usize, value: &Vector3<f64>) {
+    v[3 * i] = value.x;
+    v[3 * i + 1] = value.y;
+    v[3 * i + 2] = value.z;
+}
+
+/// Adds to node `i` of a flat `3N` vector.
+#[inline]
+pub fn add_node(v: &mut [f64], i: usize, value: &Vector3<f64>) {
+    v[3 * i] += value.x;
+    v[3 * i + 1] += value.y;
+    v[3 * i + 2] += value.z;
+}
+
+/// The rotation closest to `a` in the Frobenius norm (rotation factor of the polar
+/// decomposition `a = R P`), with `det R = +1` even when `det a < 0` (SVD with the sign fix).
+/// Allocation-free (3×3 SVD on the stack).
+pub fn nearest_rotation(a: &Matrix3<f64>) -> Matrix3<f64> {
+    let svd = a.svd(true, true);
+    let (u, v_t) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let d = (u * v_t).determinant().signum();
+    u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * v_t
+}
+
+/// Weights and reference geometry of a best-fit frame over a set of nodes: positive weights
+/// `w_i` (kg, HRZ-lumped masses for the body frame), the weighted reference centroid `X_c` and
+/// the reference offsets `X̄_i = X_i − X_c`.
+#[derive(Debug, Clone)]
+pub struct FrameWeights {
+    pub nodes: Vec<usize>,
+    pub weights: Vec<f64>,
+    pub total_weight: f64,
+    pub reference_centroid: Vector3<f64>,
+    pub reference_offsets: Vec<Vector3<f64>>,
+}
+
+/// A frame: origin `c` (m) and rotation `R` (columns: frame axes in global coordinates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub origin: Vector3<f64>,
+    pub rotation: Matrix3<f64>,
+}
+
+impl FrameWeights {
+    /// `nodes` with positive `weights`, reference positions taken from `reference` (flat `3N`).
+    pub fn new(nodes: Vec<usize>, weights: Vec<f64>, reference: &[f64]) -> FrameWeights {
+        assert_eq!(nodes.len(), weights.len());
+        assert!(weights.iter().all(|&w| w > 0.0), "frame weights must be positive");
+        let total_weight: f64 = weights.iter().sum();
+        let mut centroid = Vector3::zeros();
+        for (&n, &w) in nodes.iter().zip(&weights) {
+            centroid += w * node(reference, n);
+        }
+        centroid /= total_weight;
+        let reference_offsets = nodes.iter().map(|&n| node(reference, n) - centroid).collect();
+        FrameWeights {
+            nodes,
+            weights,
+            total_weight,
+            reference_centroid: centroid,
+            reference_offsets,
+        }
+    }
+
+    /// Weighted centroid `c = Σ w_i x_i / Σ w_i` of a flat `3N` vector `x` (positions,
+    /// velocities or accelerations).
+    pub fn centroid(&self, x: &[f64]) -> Vector3<f64> {
+        let mut c = Vector3::zeros();
+        for (&n, &w) in self.nodes.iter().zip(&self.weights) {
+            c += w * node(x, n);
+        }
+        c / self.total_weight
+    }
+
+    /// The best-fit frame of positions `x`: `c` and `R = polar(Σ w_i (x_i − c) X̄_iᵀ)`.
+    pub fn best_fit(&self, x: &[f64]) -> Frame {
+        let origin = self.centroid(x);
+        let mut a = Matrix3::zeros();
+        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+            a += w * (node(x, n) - origin) * xbar.transpose();
+        }
+        Frame {
+            origin,
+            rotation: nearest_rotation(&a),
+        }
+    }
+
+    /// `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×` for the frame `frame` of positions `x` (≈ minus the
+    /// weighted inertia tensor; DESIGN.md section 2). It maps the frame's rotation variation:
+    /// `H δθ = −Σ w_i X̄_i × Rᵀ δx_i` (body-frame `δθ`).
+    pub fn rotation_sensitivity(&self, frame: &Frame, x: &[f64]) -> Matrix3<f64> {
+        let mut h = Matrix3::zeros();
+        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+            let y = frame.rotation.transpose() * (node(x, n) - frame.origin); // X̄_i + ū_i
+            h += w * skew(xbar) * skew(&y);
+        }
+        h
+    }
+
+    /// Body-frame angular velocity of the best-fit frame, `ω̄ = −H⁻¹ Σ w_i X̄_i × Rᵀ ẋ_i`
+    /// (rad/s); `h_inv` is `H⁻¹` from [`Self::rotation_sensitivity`].
+    pub fn angular_velocity(&self, frame: &Frame, h_inv: &Matrix3<f64>, v: &[f64]) -> Vector3<f64> {
+        let mut b = Vector3::zeros();
+        let rt = frame.rotation.transpose();
+        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+            b += w * xbar.cross(&(rt * node(v, n)));
+        }
+        -(h_inv * b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Rotation3;
+
+    fn cloud() -> Vec<f64> {
+        // an irregular cloud of 7 points
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [0.2, 0.8, 0.1],
+            [0.3, 0.2, 0.9],
+            [1.1, 0.9, 0.3],
+            [0.7, 0.1, 0.6],
+            [0.1, 0.6, 0.7],
+        ];
+        p.iter().flatten().copied().collect()
+    }
+
+    #[test]
+    fn best_fit_of_a_rigid_motion_is_that_motion() {
+        let reference = cloud();
+        let n = reference.len() / 3;
+        let weights: Vec<f64> = (0..n).map(|i| 1.0 + i as f64 * 0.3).collect();
+        let fw = FrameWeights::new((0..n).collect(), weights, &reference);
+        let q = *Rotation3::from_scaled_axis(Vector3::new(2.0, -1.0, 0.5)).matrix();
+        let p = Vector3::new(3.0, -2.0, 1.0);
+        let mut x = vec![0.0; 3 * n];
+        for i in 0..n {
+            set_node(&mut x, i, &(p + q * node(&reference, i)));
+        }
+        let f = fw.best_fit(&x);
+        assert!((f.rotation - q).norm() < 1e-12);
+        assert!((f.origin - (p + q * fw.reference_centroid)).norm() < 1e-12);
+    }
+
+    #[test]
+    fn angular_velocity_of_a_rigid_rotation() {
+        let reference = cloud();
+        let n = reference.len() / 3;
+        let fw = FrameWeights::new((0..n).collect(), vec![1.0; n], &reference);
+        let q = *Rotation3::from_scaled_axis(Vector3::new(0.3, 0.2, -0.4)).matrix();
+        let omega = Vector3::new(0.5, -3.0, 7.0); // global
+        let mut x = vec![0.0; 3 * n];
+        let mut v = vec![0.0; 3 * n];
+        for i in 0..n {
+            let r = q * (node(&reference, i) - fw.reference_centroid);
+            set_node(&mut x, i, &r);
+            set_node(&mut v, i, &omega.cross(&r));
+        }
+        let f = fw.best_fit(&x);
+        let h_inv = fw.rotation_sensitivity(&f, &x).try_inverse().unwrap();
+        let w_body = fw.angular_velocity(&f, &h_inv, &v);
+        assert!((f.rotation * w_body - omega).norm() < 1e-12 * omega.norm());
+    }
+
+    #[test]
+    fn reflected_cloud_still_gives_a_rotation() {
+        let a = Matrix3::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0);
+        let r = nearest_rotation(&a);
+        assert!((r.determinant() - 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,204 @@
+//! Node sets of supports and interfaces (DESIGN.md section 4): an RBE3-like distribution of a
+//! force and torque over the nodes, the weighted least-squares rigid motion of the nodes that is
+//! power-conjugate to it, and the resultant of nodal loads about the reference point.
+
+use super::frame::{add_node, node, Frame, FrameWeights};
+use crate::error::{Error, Result};
+use nalgebra::{Matrix3, Vector3};
+
+/// A node set with positive weights `w_i` and a reference point.
+///
+/// With `r_i = x_i − c` (c: weighted centroid), `W = Σ w_i` and the weighted polar inertia
+/// `J = Σ w_i (|r_i|² I − r_i r_iᵀ)`:
+/// * a force `F` and torque `T` about the reference point `p` load node `i` with
+///   `f_i = w_i (F / W + θ × r_i)`, `θ = J⁻¹ (T + (p − c) × F)`, so `Σ f_i = F` and
+///   `Σ (x_i − p) × f_i = T`;
+/// * the motion reported is `ω = J⁻¹ Σ w_i r_i × ẋ_i`, `v_p = Σ w_i ẋ_i / W + ω × (p − c)`, so
+///   that `Σ f_i · ẋ_i = F · v_p + T · ω`: coupling through the interface is power-neutral.
+#[derive(Debug, Clone)]
+pub struct NodeSet {
+    pub frame_weights: FrameWeights,
+    /// Reference point in reference coordinates (m).
+    pub reference_point: Vector3<f64>,
+}
+
+/// Rigid motion of a node set at its reference point (global frame, SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InterfaceMotion {
+    pub position: Vector3<f64>,
+    pub rotation: Matrix3<f64>,
+    pub velocity: Vector3<f64>,
+    pub angular_velocity: Vector3<f64>,
+    pub acceleration: Vector3<f64>,
+    pub angular_acceleration: Vector3<f64>,
+}
+
+impl NodeSet {
+    /// A node set `nodes` weighted by `weights` (> 0); `reference_point` defaults to the weighted
+    /// centroid. Error if the set cannot carry a torque (fewer than three non-collinear nodes).
+    pub fn new(
+        name: &str,
+        nodes: Vec<usize>,
+        weights: Vec<f64>,
+        reference: &[f64],
+        reference_point: Option<Vector3<f64>>,
+    ) -> Result<NodeSet> {
+        if nodes.is_empty() {
+            return Err(Error::new(format!("interface '{name}': its node set is empty")));
+        }
+        let frame_weights = FrameWeights::new(nodes, weights, reference);
+        let j = polar_inertia(&frame_weights, reference, &frame_weights.reference_centroid);
+        let eig = j.symmetric_eigenvalues();
+        if eig.min() <= 1e-9 * eig.max() {
+            return Err(Error::new(format!(
+                "interface '{name}': its {} nodes are collinear, so the set cannot carry a torque",
+                frame_weights.nodes.len()
+            )));
+        }
+        let reference_point = reference_point.unwrap_or(frame_weights.reference_centroid);
+        Ok(NodeSet {
+            frame_weights,
+            reference_point,
+        })
+    }
+
+    /// Current position of the reference point: `c + R (p_ref − X_c)` with the best-fit frame.
+    fn reference_point_at(&self, frame: &Frame) -> Vector3<f64> {
+        frame.origin + frame.rotation * (self.reference_point - self.frame_weights.reference_centroid)
+    }
+
+    /// Adds the nodal loads of force `force` and torque `torque` about the reference point
+    /// (N, N·m, global frame) at positions `x` to `f` (flat `3N`).
+    pub fn distribute(&self, x: &[f64], force: &Vector3<f64>, torque: &Vector3<f64>, f: &mut [f64]) {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let p = self.reference_point_at(&frame);
+        let torque_c = torque + (p - frame.origin).cross(force);
+        let j = polar_inertia(fw, x, &frame.origin);
+        let theta = j.try_inverse().unwrap_or_else(Matrix3::zeros) * torque_c;
+        let per_weight = force / fw.total_weight;
+        for (&n, &w) in fw.nodes.iter().zip(&fw.weights) {
+            let r = node(x, n) - frame.origin;
+            add_node(f, n, &(w * (per_weight + theta.cross(&r))));
+        }
+    }
+
+    /// Resultant force and torque about the current reference point of the nodal loads `f`
+    /// restricted to the set.
+    pub fn resultant(&self, x: &[f64], f: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let p = self.reference_point_at(&frame);
+        let mut force = Vector3::zeros();
+        let mut torque = Vector3::zeros();
+        for &n in &fw.nodes {
+            let fi = node(f, n);
+            force += fi;
+            torque += (node(x, n) - p).cross(&fi);
+        }
+        (force, torque)
+    }
+
+    /// The weighted least-squares rigid motion of the set at positions `x`, velocities `v` and
+    /// accelerations `a`; the angular acceleration is that of the least-squares rigid acceleration
+    /// field `a_i ≈ a_c + α × r_i + ω × (ω × r_i)`.
+    pub fn motion(&self, x: &[f64], v: &[f64], a: &[f64]) -> InterfaceMotion {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let p = self.reference_point_at(&frame);
+        let d = p - frame.origin;
+        let j_inv = polar_inertia(fw, x, &frame.origin)
+            .try_inverse()
+            .unwrap_or_else(Matrix3::zeros);
+        let vc = fw.centroid(v);
+        let ac = fw.centroid(a);
+        let mut b = Vector3::zeros();
+        for (&n, &w) in fw.nodes.iter().zip(&fw.weights) {
+            b += w * (node(x, n) - frame.origin).cross(&node(v, n));
+        }
+        let omega = j_inv * b;
+        let mut b = Vector3::zeros();
+        for (&n, &w) in fw.nodes.iter().zip(&fw.weights) {
+            let r = node(x, n) - frame.origin;
+            let centripetal = omega.cross(&omega.cross(&r));
+            b += w * r.cross(&(node(a, n) - ac - centripetal));
+        }
+        let alpha = j_inv * b;
+        InterfaceMotion {
+            position: p,
+            rotation: frame.rotation,
+            velocity: vc + omega.cross(&d),
+            angular_velocity: omega,
+            acceleration: ac + alpha.cross(&d) + omega.cross(&omega.cross(&d)),
+            angular_acceleration: alpha,
+        }
+    }
+}
+
+/// `J = Σ w_i (|r_i|² I − r_i r_iᵀ)`, `r_i = x_i − c` (kg·m²).
+fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64> {
+    let mut j = Matrix3::zeros();
+    for (&n, &w) in fw.nodes.iter().zip(&fw.weights) {
+        let r = node(x, n) - c;
+        j += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
+    }
+    j
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::frame::set_node;
+
+    fn face() -> (Vec<f64>, NodeSet) {
+        // 3×3 grid of nodes in the plane x = 1 with unequal weights
+        let mut x = Vec::new();
+        for j in 0..3 {
+            for k in 0..3 {
+                x.extend_from_slice(&[1.0, 0.01 * j as f64 - 0.01, 0.01 * k as f64 - 0.01]);
+            }
+        }
+        let weights = (0..9).map(|i| 1.0 + (i % 4) as f64).collect();
+        let set = NodeSet::new("tip", (0..9).collect(), weights, &x, Some(Vector3::new(1.0, 0.0, 0.0)))
+            .unwrap();
+        (x, set)
+    }
+
+    #[test]
+    fn distributed_load_has_the_given_resultant() {
+        let (x, set) = face();
+        let force = Vector3::new(1.0, -10.0, 3.0);
+        let torque = Vector3::new(0.5, 0.2, -0.1);
+        let mut f = vec![0.0; x.len()];
+        set.distribute(&x, &force, &torque, &mut f);
+        let (rf, rt) = set.resultant(&x, &f);
+        assert!((rf - force).norm() < 1e-12);
+        assert!((rt - torque).norm() < 1e-12);
+    }
+
+    #[test]
+    fn reported_motion_is_power_conjugate() {
+        let (x, set) = face();
+        let n = x.len() / 3;
+        // an arbitrary (non-rigid) velocity field
+        let mut v = vec![0.0; x.len()];
+        for i in 0..n {
+            set_node(&mut v, i, &Vector3::new((i as f64).sin(), (2.0 * i as f64).cos(), 0.3 * i as f64));
+        }
+        let force = Vector3::new(1.0, -10.0, 3.0);
+        let torque = Vector3::new(0.5, 0.2, -0.1);
+        let mut f = vec![0.0; x.len()];
+        set.distribute(&x, &force, &torque, &mut f);
+        let nodal_power: f64 = f.iter().zip(&v).map(|(a, b)| a * b).sum();
+        let m = set.motion(&x, &v, &v);
+        let power = force.dot(&m.velocity) + torque.dot(&m.angular_velocity);
+        assert!((nodal_power - power).abs() < 1e-12 * nodal_power.abs().max(1.0));
+    }
+
+    #[test]
+    fn collinear_set_is_rejected() {
+        let x = vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0];
+        let e = NodeSet::new("line", vec![0, 1, 2], vec![1.0; 3], &x, None).unwrap_err();
+        assert!(e.message.contains("collinear"), "{e}");
+    }
+}
