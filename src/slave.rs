@@ -467,9 +467,13 @@ impl Slave {
     }
 
     /// Sets a Real parameter or input; rejects NaN, infinities and out-of-range values with a
-    /// message naming the variable; a rejected value changes nothing.
+    /// message naming the variable; a rejected value changes nothing. Allocation-free unless it
+    /// fails.
     pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
-        let v = self.lookup(VariableType::Real, vr)?;
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
         match v.target {
             Target::Fixed { key, component } => {
                 Parameters::check_real(&v.name, key, value)?;

@@ -1,0 +1,44 @@
+//! Helpers shared by the integration tests: drive a [`Slave`] by variable name.
+#![allow(dead_code)]
+
+use flexbody::model::{BodyFile, VariableType};
+use flexbody::slave::Slave;
+
+/// Timoshenko tip deflection of B1 under 10 N (BENCHMARKS.md), m.
+pub const B1_TIMOSHENKO_DEFLECTION: f64 = 1.19084e-3;
+/// First bending frequency of B1 (Euler–Bernoulli), Hz.
+pub const B1_FIRST_FREQUENCY: f64 = 16.710;
+
+pub fn vr(slave: &Slave, name: &str) -> u32 {
+    slave
+        .variables()
+        .by_name(name)
+        .unwrap_or_else(|| panic!("no variable {name}"))
+        .value_reference
+}
+
+pub fn set(slave: &mut Slave, name: &str, value: f64) {
+    let v = slave.variables().by_name(name).unwrap().clone();
+    match v.ty {
+        VariableType::Real => slave.set_real(v.value_reference, value).unwrap(),
+        VariableType::Integer => slave.set_integer(v.value_reference, value as i32).unwrap(),
+        VariableType::Boolean => slave.set_boolean(v.value_reference, value != 0.0).unwrap(),
+    }
+}
+
+pub fn get(slave: &mut Slave, name: &str) -> f64 {
+    let r = vr(slave, name);
+    slave.get_real(r).unwrap()
+}
+
+/// The default body (B1), instantiated, with `settings` applied, initialized at t = 0.
+pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
+    let mut slave = Slave::from_body(BodyFile::default_body()).unwrap();
+    slave.setup_experiment(0.0, None, None).unwrap();
+    slave.enter_initialization_mode().unwrap();
+    for (name, value) in settings {
+        set(&mut slave, name, *value);
+    }
+    slave.exit_initialization_mode().unwrap();
+    slave
+}

@@ -1,0 +1,63 @@
+//! The hot path: after the first step at a step size, `do_step` and reading the outputs allocate
+//! nothing (DEVELOPERS.md). A counting global allocator watches this test binary.
+
+mod common;
+use common::*;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn do_step_does_not_allocate_after_the_first_step() {
+    let mut s = initialized_default(&[
+        ("damping.alpha", 1.0),
+        ("damping.beta", 1e-4),
+        ("gravity[3]", -9.81),
+        ("tip.force[2]", -10.0),
+        ("model.nonlinearForces", 1.0),
+    ]);
+    let names: Vec<u32> = s
+        .variables()
+        .iter()
+        .filter(|v| v.causality == flexbody::model::Causality::Output)
+        .map(|v| v.value_reference)
+        .collect();
+    let force_x = vr(&s, "tip.force[1]");
+    let h = 1e-3;
+    // First step at this communication step size (factorization allowed), then a step split into
+    // two internal steps (another factorization allowed).
+    s.do_step(0.0, h).unwrap();
+    s.do_step(h, 2.0 * h).unwrap();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let mut t = 3.0 * h;
+    for k in 0..20 {
+        let big = if k % 2 == 0 { h } else { 2.0 * h };
+        s.do_step(t, big).unwrap();
+        t += big;
+        s.set_real(force_x, k as f64).unwrap();
+        for &vr in &names {
+            s.get_real(vr).unwrap();
+        }
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert_eq!(after - before, 0, "{} allocations in 20 steps", after - before);
+}
