@@ -151,6 +151,14 @@ struct Outputs {
     interfaces: Vec<[f64; 30]>,
 }
 
+/// A message for the importer's logger that is not an error: `category` is one of the declared
+/// log categories (`logEvents`, `logSolver`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogEvent {
+    pub category: &'static str,
+    pub message: String,
+}
+
 /// One instance of the flexible body.
 pub struct Slave {
     body_file: BodyFile,
@@ -171,6 +179,10 @@ pub struct Slave {
     /// Backup of the dynamics at the start of a communication step (rollback on failure).
     backup: Option<DynamicState>,
     outputs: Outputs,
+    /// Internal steps and fixed-point iterations since initialization.
+    statistics: (u64, u64),
+    /// Messages for the logger, drained by the FMI layer after each call.
+    events: Vec<LogEvent>,
 }
 
 impl Slave {
@@ -265,6 +277,8 @@ impl Slave {
                 interfaces: vec![[0.0; 30]; n_interfaces],
                 ..Outputs::default()
             },
+            statistics: (0, 0),
+            events: Vec::new(),
         })
     }
 
@@ -348,6 +362,16 @@ impl Slave {
     /// The assembled body once initialized.
     pub fn body(&self) -> Option<&Body> {
         self.model.as_ref().map(|m| &m.body)
+    }
+
+    /// Takes the log messages produced since the last call (none on the hot path).
+    pub fn drain_events(&mut self) -> std::vec::Drain<'_, LogEvent> {
+        self.events.drain(..)
+    }
+
+    /// Internal steps taken and fixed-point iterations done since instantiation.
+    pub fn solver_statistics(&self) -> (u64, u64) {
+        self.statistics
     }
 
     /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values). The
@@ -618,9 +642,15 @@ impl Slave {
                 &mut dynamics.state,
                 &mut model.workspace,
             );
-            if let Err(e) = r {
-                result = Err(e);
-                break;
+            match r {
+                Ok(report) => {
+                    self.statistics.0 += 1;
+                    self.statistics.1 += report.iterations as u64;
+                }
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
             }
         }
         if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
@@ -669,8 +699,22 @@ impl Slave {
                 damping_beta: p.damping_beta,
             },
         );
+        let started = std::time::Instant::now();
         let free = FreeNodes::new(&body, &self.clamped);
         let workspace = StepWorkspace::new(&body, &free);
+        self.events.push(LogEvent {
+            category: "logEvents",
+            message: format!(
+                "assembled the body: {} nodes, {} elements, {} DOF ({} free), nnz(K) = {}, mass {:.6e} kg ({:.3} s)",
+                body.node_count(),
+                self.mesh.element_count(),
+                body.reference.len(),
+                free.dof_count(),
+                body.stiffness_matrix.nnz(),
+                body.total_mass,
+                started.elapsed().as_secs_f64()
+            ),
+        });
         self.model = Some(Model {
             key,
             body,
@@ -695,6 +739,7 @@ impl Slave {
         {
             return Ok(i);
         }
+        let started = std::time::Instant::now();
         let matrix = IterationMatrix::new(
             &model.free,
             &model.scheme,
@@ -702,6 +747,14 @@ impl Slave {
             p.damping_alpha,
             p.damping_beta,
         )?;
+        self.events.push(LogEvent {
+            category: "logEvents",
+            message: format!(
+                "factorised the iteration matrix for internal step h = {h:e} s: nnz(L) = {} ({:.3} s); it serves every step of this size",
+                matrix.factor.factor_nnz(),
+                started.elapsed().as_secs_f64()
+            ),
+        });
         if model.matrices.len() >= MATRIX_CACHE_SIZE {
             model.matrices.remove(0);
         }
