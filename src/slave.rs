@@ -9,7 +9,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::fem::{self, IsotropicMaterial};
 use crate::mesh::{self, Mesh};
 use crate::model::body_file::MeshSpec;
-use crate::model::model_description::{model_description, ModelInfo};
+use crate::model::model_description::{format_real, model_description, ModelInfo};
 use crate::model::variables::{FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
 use crate::solver::generalized_alpha::{
@@ -440,7 +440,7 @@ impl Slave {
                 read_integer(&self.defaults, key).unwrap_or(0).to_string()
             }
             (VariableType::Real, Target::Fixed { key, component }) => {
-                format!("{:?}", read_parameter(&self.defaults, key, component).unwrap_or(0.0))
+                format_real(read_parameter(&self.defaults, key, component).unwrap_or(0.0))
             }
             _ => "0.0".to_string(),
         }

@@ -61,6 +61,10 @@ pub trait CoSimSlave {
     fn reset(&mut self);
     fn get_state(&self) -> Self::State;
     fn set_state(&mut self, state: &Self::State) -> Result<()>;
+    /// Hands the slave's pending log messages (category, text) to `sink`.
+    fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
+        let _ = sink;
+    }
 }
 
 impl CoSimSlave for Slave {
@@ -117,6 +121,11 @@ impl CoSimSlave for Slave {
     }
     fn set_state(&mut self, state: &SlaveState) -> Result<()> {
         Slave::set_state(self, state)
+    }
+    fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
+        for e in Slave::drain_events(self) {
+            sink(e.category, &e.message);
+        }
     }
 }
 
@@ -303,6 +312,14 @@ impl<S: CoSimSlave> Instance<S> {
         }
     }
 
+    /// Passes the slave's log messages on to the logger (their categories decide whether they
+    /// reach the importer).
+    fn flush_events(&mut self) {
+        let logger = &mut self.logger;
+        self.slave
+            .drain_events(&mut |category, message| logger.log(fmi2Status::fmi2OK, category, message));
+    }
+
     /// The calling-sequence state.
     pub fn state(&self) -> MachineState {
         self.state
@@ -456,7 +473,9 @@ impl<S: CoSimSlave> Instance<S> {
         if let Err(s) = self.check_state(F, EXIT_INIT) {
             return s;
         }
-        match self.slave.exit_initialization_mode() {
+        let result = self.slave.exit_initialization_mode();
+        self.flush_events();
+        match result {
             Ok(()) => {
                 self.state = M::StepComplete;
                 self.logger
@@ -615,7 +634,9 @@ impl<S: CoSimSlave> Instance<S> {
                 &format!("communicationStepSize = {h} rejected: must be finite and > 0"),
             );
         }
-        match self.slave.do_step(t, h) {
+        let result = self.slave.do_step(t, h);
+        self.flush_events();
+        match result {
             Ok(()) => fmi2Status::fmi2OK,
             Err(e) => {
                 let status = self.report(F, &e);
