@@ -1,6 +1,8 @@
 //! Symmetric sparse matrices in compressed-row storage (both triangles stored), the storage of
 //! `Ms` and `K`, with an allocation-free product.
 
+use nalgebra::DMatrix;
+
 /// A symmetric `n × n` sparse matrix, both triangles stored, rows sorted by column.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SymmetricCsr {
@@ -12,15 +14,61 @@ pub struct SymmetricCsr {
 
 impl SymmetricCsr {
     /// From (row, col, value) triplets of the full matrix (both triangles); duplicates are summed.
+    /// Panics if an index is out of range.
     pub fn from_triplets(n: usize, triplets: &[(usize, usize, f64)]) -> SymmetricCsr {
-        let _ = (n, triplets);
-        todo!()
+        let mut sorted: Vec<(usize, usize, f64)> = triplets.to_vec();
+        for &(r, c, _) in &sorted {
+            assert!(
+                r < n && c < n,
+                "SymmetricCsr::from_triplets: ({r}, {c}) outside {n}×{n}"
+            );
+        }
+        sorted.sort_unstable_by_key(|&(r, c, _)| (r, c));
+        let mut row_ptr = vec![0usize; n + 1];
+        let mut col_idx = Vec::with_capacity(sorted.len());
+        let mut values: Vec<f64> = Vec::with_capacity(sorted.len());
+        let mut last: Option<(usize, usize)> = None;
+        for (r, c, v) in sorted {
+            if last == Some((r, c)) {
+                *values.last_mut().expect("a previous entry exists") += v;
+            } else {
+                col_idx.push(c);
+                values.push(v);
+                row_ptr[r + 1] += 1;
+                last = Some((r, c));
+            }
+        }
+        for i in 0..n {
+            row_ptr[i + 1] += row_ptr[i];
+        }
+        SymmetricCsr {
+            n,
+            row_ptr,
+            col_idx,
+            values,
+        }
     }
 
-    /// `y = A x`. No allocation.
+    /// `y = A x`. No allocation. Panics if the lengths are not `n`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        let _ = (x, y);
-        todo!()
+        assert_eq!(
+            x.len(),
+            self.n,
+            "SymmetricCsr::mul_vec: x has the wrong length"
+        );
+        assert_eq!(
+            y.len(),
+            self.n,
+            "SymmetricCsr::mul_vec: y has the wrong length"
+        );
+        for (i, yi) in y.iter_mut().enumerate() {
+            let range = self.row_ptr[i]..self.row_ptr[i + 1];
+            *yi = self.col_idx[range.clone()]
+                .iter()
+                .zip(&self.values[range])
+                .map(|(&j, &a)| a * x[j])
+                .sum();
+        }
     }
 
     /// Rows/cols `keep`, in that order.
@@ -43,5 +91,211 @@ impl SymmetricCsr {
     /// Number of stored entries (both triangles).
     pub fn nnz(&self) -> usize {
         self.values.len()
+    }
+
+    /// Column indices and values of row `i`.
+    pub fn row(&self, i: usize) -> (&[usize], &[f64]) {
+        let range = self.row_ptr[i]..self.row_ptr[i + 1];
+        (&self.col_idx[range.clone()], &self.values[range])
+    }
+
+    /// The diagonal entries (0 where none is stored).
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.n)
+            .map(|i| {
+                let (cols, vals) = self.row(i);
+                cols.binary_search(&i).map(|k| vals[k]).unwrap_or(0.0)
+            })
+            .collect()
+    }
+
+    /// The principal submatrix `A[keep, keep]`: row/column `k` of the result is row/column
+    /// `keep[k]` of `self` (e.g. the free DOFs after removing clamped ones). `keep` must hold
+    /// distinct indices `< n`.
+    pub fn submatrix(&self, keep: &[usize]) -> SymmetricCsr {
+        let mut new_index = vec![usize::MAX; self.n];
+        for (k, &old) in keep.iter().enumerate() {
+            assert!(
+                old < self.n,
+                "SymmetricCsr::submatrix: index {old} ≥ {}",
+                self.n
+            );
+            assert_eq!(
+                new_index[old],
+                usize::MAX,
+                "SymmetricCsr::submatrix: {old} repeated"
+            );
+            new_index[old] = k;
+        }
+        let mut row_ptr = Vec::with_capacity(keep.len() + 1);
+        row_ptr.push(0);
+        let mut col_idx = Vec::new();
+        let mut values = Vec::new();
+        let mut row_entries: Vec<(usize, f64)> = Vec::new();
+        for &old in keep {
+            row_entries.clear();
+            let (cols, vals) = self.row(old);
+            for (&c, &v) in cols.iter().zip(vals) {
+                if new_index[c] != usize::MAX {
+                    row_entries.push((new_index[c], v));
+                }
+            }
+            row_entries.sort_unstable_by_key(|e| e.0);
+            for &(c, v) in &row_entries {
+                col_idx.push(c);
+                values.push(v);
+            }
+            row_ptr.push(col_idx.len());
+        }
+        SymmetricCsr {
+            n: keep.len(),
+            row_ptr,
+            col_idx,
+            values,
+        }
+    }
+
+    /// The Kronecker product `A ⊗ I3` (`3n × 3n`): entry `(3i+d, 3j+d) = A[i,j]`, DOF `3*i + d`.
+    pub fn kron_i3(&self) -> SymmetricCsr {
+        let n3 = 3 * self.n;
+        let mut row_ptr = Vec::with_capacity(n3 + 1);
+        row_ptr.push(0);
+        let mut col_idx = Vec::with_capacity(3 * self.nnz());
+        let mut values = Vec::with_capacity(3 * self.nnz());
+        for i in 0..self.n {
+            let (cols, vals) = self.row(i);
+            for d in 0..3 {
+                for (&c, &v) in cols.iter().zip(vals) {
+                    col_idx.push(3 * c + d);
+                    values.push(v);
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        SymmetricCsr {
+            n: n3,
+            row_ptr,
+            col_idx,
+            values,
+        }
+    }
+
+    /// `a A + b B` on the union of the two patterns (same dimension required), e.g. the iteration
+    /// matrix `c_m M + K`.
+    pub fn linear_combination(
+        a: f64,
+        lhs: &SymmetricCsr,
+        b: f64,
+        rhs: &SymmetricCsr,
+    ) -> SymmetricCsr {
+        assert_eq!(
+            lhs.n, rhs.n,
+            "SymmetricCsr::linear_combination: dimensions differ"
+        );
+        let n = lhs.n;
+        let mut row_ptr = Vec::with_capacity(n + 1);
+        row_ptr.push(0);
+        let mut col_idx = Vec::with_capacity(lhs.nnz().max(rhs.nnz()));
+        let mut values = Vec::with_capacity(lhs.nnz().max(rhs.nnz()));
+        for i in 0..n {
+            let (ca, va) = lhs.row(i);
+            let (cb, vb) = rhs.row(i);
+            let (mut p, mut q) = (0, 0);
+            while p < ca.len() || q < cb.len() {
+                let next_a = ca.get(p).copied().unwrap_or(usize::MAX);
+                let next_b = cb.get(q).copied().unwrap_or(usize::MAX);
+                if next_a < next_b {
+                    col_idx.push(next_a);
+                    values.push(a * va[p]);
+                    p += 1;
+                } else if next_b < next_a {
+                    col_idx.push(next_b);
+                    values.push(b * vb[q]);
+                    q += 1;
+                } else {
+                    col_idx.push(next_a);
+                    values.push(a * va[p] + b * vb[q]);
+                    p += 1;
+                    q += 1;
+                }
+            }
+            row_ptr.push(col_idx.len());
+        }
+        SymmetricCsr {
+            n,
+            row_ptr,
+            col_idx,
+            values,
+        }
+    }
+
+    /// The dense matrix (for tests and small problems).
+    pub fn to_dense(&self) -> DMatrix<f64> {
+        let mut m = DMatrix::zeros(self.n, self.n);
+        for i in 0..self.n {
+            let (cols, vals) = self.row(i);
+            for (&c, &v) in cols.iter().zip(vals) {
+                m[(i, c)] += v;
+            }
+        }
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [[4, 1, 0], [1, 3, 2], [0, 2, 5]] from triplets with a split duplicate.
+    fn sample() -> SymmetricCsr {
+        SymmetricCsr::from_triplets(
+            3,
+            &[
+                (2, 2, 5.0),
+                (0, 0, 3.0),
+                (0, 1, 1.0),
+                (1, 0, 1.0),
+                (1, 1, 3.0),
+                (0, 0, 1.0),
+                (1, 2, 2.0),
+                (2, 1, 2.0),
+            ],
+        )
+    }
+
+    #[test]
+    fn triplets_sum_duplicates_and_sort_rows() {
+        let a = sample();
+        assert_eq!(a.row_ptr, vec![0, 2, 5, 7]);
+        assert_eq!(a.col_idx, vec![0, 1, 0, 1, 2, 1, 2]);
+        assert_eq!(a.values, vec![4.0, 1.0, 1.0, 3.0, 2.0, 2.0, 5.0]);
+        let mut y = [0.0; 3];
+        a.mul_vec(&[1.0, -1.0, 2.0], &mut y);
+        assert_eq!(y, [3.0, 2.0, 8.0]);
+        assert_eq!(a.diagonal(), vec![4.0, 3.0, 5.0]);
+    }
+
+    #[test]
+    fn submatrix_kron_and_linear_combination_match_dense() {
+        let a = sample();
+        let dense = a.to_dense();
+        let sub = a.submatrix(&[2, 0]);
+        let ds = sub.to_dense();
+        assert_eq!(ds[(0, 0)], dense[(2, 2)]);
+        assert_eq!(ds[(0, 1)], dense[(2, 0)]);
+        assert_eq!(ds[(1, 1)], dense[(0, 0)]);
+        assert_eq!(sub.nnz(), 2); // (2,0) is structurally absent
+
+        let k = a.kron_i3().to_dense();
+        let expected = dense.kronecker(&DMatrix::<f64>::identity(3, 3));
+        assert_eq!(k, expected);
+
+        let b = SymmetricCsr::from_triplets(3, &[(0, 2, 1.0), (2, 0, 1.0), (1, 1, 1.0)]);
+        let c = SymmetricCsr::linear_combination(2.0, &a, -3.0, &b);
+        assert_eq!(c.to_dense(), dense * 2.0 - b.to_dense() * 3.0);
+        for i in 0..3 {
+            let (cols, _) = c.row(i);
+            assert!(cols.windows(2).all(|w| w[0] < w[1]));
+        }
     }
 }

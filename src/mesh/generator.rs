@@ -1,10 +1,16 @@
 //! Structured meshes of boxes ("beams").
 
 use super::{ElementKind, Mesh};
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::fem::element::natural_coordinates;
 
 /// A box `[0, length] × [−width/2, width/2] × [−height/2, height/2]` (m) meshed with
 /// `divisions = [nx, ny, nz]` elements of `kind`. The beam axis is x, width along y, height along z.
+///
+/// Nodes lie on a lattice of spacing `(length/nx, width/ny, height/nz)` (Hex8) or half of it
+/// (Hex20: corners at even lattice indices, mid-edge nodes where exactly one index is odd; no
+/// face or body centres). Nodes are numbered with z fastest, then y, then x, so the nodes of one
+/// cross-section are contiguous. Element `(i, j, k)` has index `(i · ny + j) · nz + k`.
 pub fn beam(
     length: f64,
     width: f64,
@@ -12,6 +18,149 @@ pub fn beam(
     divisions: [usize; 3],
     kind: ElementKind,
 ) -> Result<Mesh> {
-    let _ = (length, width, height, divisions, kind);
-    todo!("beam generator")
+    for (name, value) in [
+        ("beam.length", length),
+        ("beam.width", width),
+        ("beam.height", height),
+    ] {
+        if !value.is_finite() || value <= 0.0 {
+            return Err(Error::invalid_value(
+                name,
+                value,
+                "must be positive and finite",
+            ));
+        }
+    }
+    if divisions.contains(&0) {
+        return Err(Error::invalid_value(
+            "beam.divisions",
+            format!("{divisions:?}"),
+            "every division count must be at least 1",
+        ));
+    }
+    // Lattice points per element edge minus one: 1 (Hex8) or 2 (Hex20).
+    let step = match kind {
+        ElementKind::Hex8 => 1,
+        ElementKind::Hex20 => 2,
+    };
+    let lattice = [
+        step * divisions[0] + 1,
+        step * divisions[1] + 1,
+        step * divisions[2] + 1,
+    ];
+    let is_node = |i: usize, j: usize, k: usize| match kind {
+        ElementKind::Hex8 => true,
+        ElementKind::Hex20 => (i % 2) + (j % 2) + (k % 2) <= 1,
+    };
+    let origin = [0.0, -0.5 * width, -0.5 * height];
+    let spacing = [
+        length / (step * divisions[0]) as f64,
+        width / (step * divisions[1]) as f64,
+        height / (step * divisions[2]) as f64,
+    ];
+    let mut index = vec![usize::MAX; lattice[0] * lattice[1] * lattice[2]];
+    let flat = |i: usize, j: usize, k: usize| (i * lattice[1] + j) * lattice[2] + k;
+    let mut nodes = Vec::new();
+    for i in 0..lattice[0] {
+        for j in 0..lattice[1] {
+            for k in 0..lattice[2] {
+                if is_node(i, j, k) {
+                    index[flat(i, j, k)] = nodes.len();
+                    // The last lattice point is placed exactly on the far face.
+                    let coord = |d: usize, m: usize, total: f64| {
+                        if m + 1 == lattice[d] {
+                            origin[d] + total
+                        } else {
+                            origin[d] + m as f64 * spacing[d]
+                        }
+                    };
+                    nodes.push([coord(0, i, length), coord(1, j, width), coord(2, k, height)]);
+                }
+            }
+        }
+    }
+    let natural = natural_coordinates(kind);
+    let mut connectivity =
+        Vec::with_capacity(divisions[0] * divisions[1] * divisions[2] * kind.node_count());
+    for i in 0..divisions[0] {
+        for j in 0..divisions[1] {
+            for k in 0..divisions[2] {
+                for xi in natural {
+                    // Natural coordinate −1, 0, 1 ↦ lattice offset 0, step/2, step.
+                    let offset = |c: f64| ((c + 1.0) * 0.5 * step as f64).round() as usize;
+                    let (li, lj, lk) = (
+                        step * i + offset(xi[0]),
+                        step * j + offset(xi[1]),
+                        step * k + offset(xi[2]),
+                    );
+                    let node = index[flat(li, lj, lk)];
+                    debug_assert_ne!(node, usize::MAX);
+                    connectivity.push(node);
+                }
+            }
+        }
+    }
+    Mesh::new(nodes, kind, connectivity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn node_and_element_counts() {
+        let m = beam(1.0, 0.1, 0.2, [4, 2, 3], ElementKind::Hex8).unwrap();
+        assert_eq!(m.node_count(), 5 * 3 * 4);
+        assert_eq!(m.element_count(), 24);
+        let m = beam(1.0, 0.1, 0.2, [4, 2, 3], ElementKind::Hex20).unwrap();
+        // corners + x-, y-, z-edges
+        let corners = 5 * 3 * 4;
+        let edges = 4 * 3 * 4 + 5 * 2 * 4 + 5 * 3 * 3;
+        assert_eq!(m.node_count(), corners + edges);
+        assert_eq!(m.element_count(), 24);
+        let (lo, hi) = m.bounding_box();
+        assert_eq!(lo, [0.0, -0.05, -0.1]);
+        assert_eq!(hi, [1.0, 0.05, 0.1]);
+    }
+
+    #[test]
+    fn element_nodes_follow_vtk_order() {
+        // One element: node positions are the natural coordinates mapped onto the box.
+        for kind in [ElementKind::Hex8, ElementKind::Hex20] {
+            let m = beam(2.0, 1.0, 4.0, [1, 1, 1], kind).unwrap();
+            for (a, xi) in natural_coordinates(kind).iter().enumerate() {
+                let x = m.nodes()[m.element(0)[a]];
+                let expected = [1.0 + xi[0], 0.5 * xi[1], 2.0 * xi[2]];
+                assert_eq!(x, expected, "{kind:?} local node {a}");
+            }
+        }
+    }
+
+    #[test]
+    fn rejects_bad_sizes_and_divisions() {
+        let e = beam(0.0, 1.0, 1.0, [1, 1, 1], ElementKind::Hex8).unwrap_err();
+        assert!(
+            e.message.starts_with("beam.length = 0 rejected"),
+            "{}",
+            e.message
+        );
+        let e = beam(1.0, -1.0, 1.0, [1, 1, 1], ElementKind::Hex8).unwrap_err();
+        assert!(
+            e.message.starts_with("beam.width = -1 rejected"),
+            "{}",
+            e.message
+        );
+        let e = beam(1.0, 1.0, f64::NAN, [1, 1, 1], ElementKind::Hex20).unwrap_err();
+        assert!(
+            e.message.starts_with("beam.height = NaN rejected"),
+            "{}",
+            e.message
+        );
+        let e = beam(1.0, 1.0, 1.0, [1, 0, 1], ElementKind::Hex20).unwrap_err();
+        assert!(
+            e.message.contains("beam.divisions = [1, 0, 1]"),
+            "{}",
+            e.message
+        );
+    }
 }

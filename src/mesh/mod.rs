@@ -42,9 +42,116 @@ impl Mesh {
     /// Builds a mesh and validates it: node indices in range, every node used, no inverted or
     /// degenerate element (the Jacobian determinant is positive at every quadrature point and node);
     /// the error names the element.
+    ///
+    /// "Degenerate" means `det J ≤ 1e-12 · (h/2)³` somewhere, with `h` the largest distance between
+    /// two nodes of the element (`(h/2)³` is the size of `det J` of a cube of edge `h`): the checks
+    /// run at the points of the full integration rule and at the element's nodes.
     pub fn new(nodes: Vec<[f64; 3]>, kind: ElementKind, connectivity: Vec<usize>) -> Result<Mesh> {
-        let _ = (&nodes, kind, &connectivity);
-        Err(Error::new("Mesh::new: not implemented"))
+        let per_element = kind.node_count();
+        if nodes.is_empty() {
+            return Err(Error::new("mesh: no nodes"));
+        }
+        if connectivity.is_empty() {
+            return Err(Error::new("mesh: no elements"));
+        }
+        if connectivity.len() % per_element != 0 {
+            return Err(Error::new(format!(
+                "mesh: connectivity length {} is not a multiple of {per_element} ({kind:?} nodes per element)",
+                connectivity.len()
+            )));
+        }
+        if let Some((i, p)) = nodes
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(Error::new(format!(
+                "mesh: node {i} has a non-finite coordinate {p:?}"
+            )));
+        }
+        let mut used = vec![false; nodes.len()];
+        for (e, element) in connectivity.chunks(per_element).enumerate() {
+            for (a, &node) in element.iter().enumerate() {
+                if node >= nodes.len() {
+                    return Err(Error::new(format!(
+                        "mesh: element {e} local node {a} refers to node {node}, but the mesh has {} nodes",
+                        nodes.len()
+                    )));
+                }
+                used[node] = true;
+            }
+            for a in 0..per_element {
+                if element[a + 1..].contains(&element[a]) {
+                    return Err(Error::new(format!(
+                        "mesh: element {e} uses node {} twice (degenerate element)",
+                        element[a]
+                    )));
+                }
+            }
+        }
+        if let Some(unused) = used.iter().position(|u| !u) {
+            return Err(Error::new(format!(
+                "mesh: node {unused} is not used by any element"
+            )));
+        }
+        let mesh = Mesh {
+            nodes,
+            kind,
+            connectivity,
+        };
+        mesh.check_jacobians()?;
+        Ok(mesh)
+    }
+
+    /// The Jacobian determinant check of [`Mesh::new`].
+    fn check_jacobians(&self) -> Result<()> {
+        use crate::fem::element::{
+            full_integration_points, natural_coordinates, physical_gradients, shape_functions,
+            MAX_NODES,
+        };
+        use crate::fem::quadrature::hexahedron_rule;
+        let kind = self.kind;
+        let n = kind.node_count();
+        let mut points: Vec<[f64; 3]> = hexahedron_rule(full_integration_points(kind))
+            .iter()
+            .map(|q| q.xi)
+            .collect();
+        points.extend_from_slice(natural_coordinates(kind));
+        // Natural derivatives at every check point, computed once.
+        let mut values = [0.0; MAX_NODES];
+        let derivatives: Vec<[[f64; 3]; MAX_NODES]> = points
+            .iter()
+            .map(|xi| {
+                let mut d = [[0.0; 3]; MAX_NODES];
+                shape_functions(kind, *xi, &mut values, &mut d);
+                d
+            })
+            .collect();
+        let mut coords = [[0.0; 3]; MAX_NODES];
+        let mut gradients = [[0.0; 3]; MAX_NODES];
+        for e in 0..self.element_count() {
+            for (c, &node) in coords.iter_mut().zip(self.element(e)) {
+                *c = self.nodes[node];
+            }
+            let mut h2: f64 = 0.0;
+            for a in 0..n {
+                for b in a + 1..n {
+                    let d2: f64 = (0..3).map(|k| (coords[a][k] - coords[b][k]).powi(2)).sum();
+                    h2 = h2.max(d2);
+                }
+            }
+            let threshold = 1e-12 * (0.5 * h2.sqrt()).powi(3);
+            for (xi, d) in points.iter().zip(&derivatives) {
+                let det = physical_gradients(&coords[..n], &d[..n], &mut gradients[..n]);
+                if det.is_nan() || det <= threshold {
+                    let what = if det <= 0.0 { "inverted" } else { "degenerate" };
+                    return Err(Error::new(format!(
+                        "mesh: element {e} is {what}: Jacobian determinant {det:.6e} at natural point {xi:?} (must be > 0)"
+                    )));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Reference node positions `X` (m).
@@ -81,5 +188,78 @@ impl Mesh {
             }
         }
         (lo, hi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit cube Hex8 in VTK order.
+    fn cube() -> Vec<[f64; 3]> {
+        crate::fem::element::HEX8_NODES
+            .iter()
+            .map(|p| [0.5 * (p[0] + 1.0), 0.5 * (p[1] + 1.0), 0.5 * (p[2] + 1.0)])
+            .collect()
+    }
+
+    #[test]
+    fn valid_cube_is_accepted() {
+        let m = Mesh::new(cube(), ElementKind::Hex8, (0..8).collect()).unwrap();
+        assert_eq!(m.element_count(), 1);
+        assert_eq!(m.element(0), &[0, 1, 2, 3, 4, 5, 6, 7]);
+    }
+
+    #[test]
+    fn inverted_element_is_named() {
+        // Two cubes side by side; the second lists its faces top/bottom swapped (mirror image).
+        let mut nodes = cube();
+        nodes.extend(cube().iter().map(|p| [p[0] + 1.0, p[1], p[2]]));
+        let mut conn: Vec<usize> = (0..8).collect();
+        conn.extend([12, 13, 14, 15, 8, 9, 10, 11]);
+        let e = Mesh::new(nodes, ElementKind::Hex8, conn).unwrap_err();
+        assert!(e.message.contains("element 1 is inverted"), "{}", e.message);
+        assert!(
+            e.message.contains("-1.25"),
+            "det J = −(1/2)³ expected: {}",
+            e.message
+        );
+    }
+
+    #[test]
+    fn distorted_node_inverting_only_near_a_node_is_caught() {
+        // Pull corner 6 through the opposite corner region: det J < 0 at node 6 at least.
+        let mut nodes = cube();
+        nodes[6] = [0.1, 0.1, 0.1];
+        let e = Mesh::new(nodes, ElementKind::Hex8, (0..8).collect()).unwrap_err();
+        assert!(e.message.contains("element 0"), "{}", e.message);
+    }
+
+    #[test]
+    fn flat_element_is_degenerate() {
+        let mut nodes = cube();
+        for p in nodes.iter_mut().skip(4) {
+            p[2] = 0.0;
+        }
+        // Different nodes at the same place: reject, naming the element.
+        let e = Mesh::new(nodes, ElementKind::Hex8, (0..8).collect()).unwrap_err();
+        assert!(e.message.contains("element 0 is"), "{}", e.message);
+    }
+
+    #[test]
+    fn bad_indices_and_unused_nodes() {
+        let e = Mesh::new(cube(), ElementKind::Hex8, vec![0, 1, 2, 3, 4, 5, 6, 8]).unwrap_err();
+        assert!(
+            e.message
+                .contains("element 0 local node 7 refers to node 8"),
+            "{}",
+            e.message
+        );
+        let mut nodes = cube();
+        nodes.push([5.0, 5.0, 5.0]);
+        let e = Mesh::new(nodes, ElementKind::Hex8, (0..8).collect()).unwrap_err();
+        assert!(e.message.contains("node 8 is not used"), "{}", e.message);
+        let e = Mesh::new(cube(), ElementKind::Hex20, (0..8).collect()).unwrap_err();
+        assert!(e.message.contains("not a multiple of 20"), "{}", e.message);
     }
 }

@@ -2,51 +2,256 @@
 //! pattern, the numeric factorization once per step size, and solves that take their workspace so
 //! that a time step does not allocate.
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::fem::SymmetricCsr;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltParams;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Conj, MatMut, Par, Side, Spec};
 
 /// The factor of a symmetric positive definite matrix.
 pub struct SparseCholesky {
-    // faer symbolic factor, numeric values
+    n: usize,
+    /// Compressed-column pattern of the lower triangle of the factored matrix (row `i ≥ j` in
+    /// column `j`); for a symmetric CSR matrix it is the upper part of each CSR row.
+    lower_col_ptr: Vec<usize>,
+    lower_row_idx: Vec<usize>,
+    /// The values of that lower triangle (scratch reused by [`Self::refactor`]).
+    lower_values: Vec<f64>,
+    symbolic: SymbolicCholesky<usize>,
+    /// Numeric values of `L`, `symbolic.len_val()` of them.
+    factor_values: Vec<f64>,
+    /// Workspace of the numeric factorization.
+    factor_workspace: MemBuffer,
 }
 
 /// Workspace for [`SparseCholesky::solve_in_place`], sized by [`SparseCholesky::solve_scratch`].
 pub struct SolveWorkspace {
-    // faer MemBuffer
+    buffer: MemBuffer,
 }
 
 impl SparseCholesky {
     /// Symbolic analysis of the pattern of `matrix` (its lower triangle is used) and the numeric
     /// factorization of its values. Error if the matrix is not positive definite.
     pub fn new(matrix: &SymmetricCsr) -> Result<SparseCholesky> {
-        let _ = matrix;
-        todo!()
+        let n = matrix.n;
+        let mut lower_col_ptr = Vec::with_capacity(n + 1);
+        lower_col_ptr.push(0);
+        let mut lower_row_idx = Vec::new();
+        for i in 0..n {
+            let (cols, _) = matrix.row(i);
+            lower_row_idx.extend(cols.iter().copied().filter(|&c| c >= i));
+            lower_col_ptr.push(lower_row_idx.len());
+        }
+        let pattern =
+            SymbolicSparseColMatRef::new_checked(n, n, &lower_col_ptr, None, &lower_row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| Error::new(format!("sparse Cholesky: symbolic analysis failed: {e:?}")))?;
+        let factor_workspace = MemBuffer::new(
+            symbolic
+                .factorize_numeric_llt_scratch::<f64>(Par::Seq, Spec::<LltParams, f64>::default()),
+        );
+        let mut this = SparseCholesky {
+            n,
+            lower_values: vec![0.0; lower_row_idx.len()],
+            factor_values: vec![0.0; symbolic.len_val()],
+            lower_col_ptr,
+            lower_row_idx,
+            symbolic,
+            factor_workspace,
+        };
+        this.refactor(matrix)?;
+        Ok(this)
     }
 
     /// Numeric factorization of new values on the same pattern (the symbolic analysis is reused).
+    /// Error if the pattern differs from the one analysed or the matrix is not positive definite
+    /// (the factor is then unusable until a successful `refactor`).
     pub fn refactor(&mut self, matrix: &SymmetricCsr) -> Result<()> {
-        let _ = matrix;
-        todo!()
+        if matrix.n != self.n {
+            return Err(Error::new(format!(
+                "sparse Cholesky: matrix dimension {} differs from the analysed {}",
+                matrix.n, self.n
+            )));
+        }
+        let mut k = 0;
+        for i in 0..self.n {
+            let (cols, vals) = matrix.row(i);
+            let expected = &self.lower_row_idx[self.lower_col_ptr[i]..self.lower_col_ptr[i + 1]];
+            let mut m = 0;
+            for (&c, &v) in cols.iter().zip(vals) {
+                if c < i {
+                    continue;
+                }
+                if expected.get(m) != Some(&c) {
+                    return Err(Error::new(format!(
+                        "sparse Cholesky: the sparsity pattern of row {i} differs from the analysed one"
+                    )));
+                }
+                if !v.is_finite() {
+                    return Err(Error::new(format!(
+                        "sparse Cholesky: entry ({i}, {c}) = {v} is not finite"
+                    )));
+                }
+                self.lower_values[k] = v;
+                k += 1;
+                m += 1;
+            }
+            if m != expected.len() {
+                return Err(Error::new(format!(
+                    "sparse Cholesky: the sparsity pattern of row {i} differs from the analysed one"
+                )));
+            }
+        }
+        let pattern = SymbolicSparseColMatRef::new_checked(
+            self.n,
+            self.n,
+            &self.lower_col_ptr,
+            None,
+            &self.lower_row_idx,
+        );
+        let a = SparseColMatRef::new(pattern, &self.lower_values);
+        let result = self.symbolic.factorize_numeric_llt::<f64>(
+            &mut self.factor_values,
+            a,
+            Side::Lower,
+            Default::default(),
+            Par::Seq,
+            MemStack::new(&mut self.factor_workspace),
+            Spec::<LltParams, f64>::default(),
+        );
+        match result {
+            Ok(_) => Ok(()),
+            Err(e) => Err(Error::new(format!(
+                "sparse Cholesky: the matrix ({n}×{n}) is not positive definite ({e:?}, index in the AMD-permuted order)",
+                n = self.n
+            ))),
+        }
     }
 
     /// Workspace for [`Self::solve_in_place`] (allocate once, reuse for every solve).
     pub fn solve_scratch(&self) -> SolveWorkspace {
-        todo!()
+        SolveWorkspace {
+            buffer: MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+        }
     }
 
     /// `rhs ← A⁻¹ rhs`: one forward and one backward triangular solve, no allocation.
+    /// Panics if `rhs.len() != self.dim()` or the workspace belongs to another factor size.
     pub fn solve_in_place(&self, rhs: &mut [f64], workspace: &mut SolveWorkspace) {
-        let _ = (rhs, workspace);
-        todo!()
+        assert_eq!(
+            rhs.len(),
+            self.n,
+            "SparseCholesky::solve_in_place: wrong rhs length"
+        );
+        let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &self.factor_values);
+        let rhs = MatMut::from_column_major_slice_mut(rhs, self.n, 1);
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut workspace.buffer),
+        );
     }
 
     /// Dimension of the factored matrix.
     pub fn dim(&self) -> usize {
-        todo!()
+        self.n
     }
 
     /// Stored nonzeros of the factor `L`.
     pub fn factor_nnz(&self) -> usize {
-        todo!()
+        self.factor_values.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The 1D Laplacian tridiag(−1, 2, −1) of size n (SPD).
+    fn laplacian(n: usize) -> SymmetricCsr {
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push((i, i, 2.0));
+            if i + 1 < n {
+                t.push((i, i + 1, -1.0));
+                t.push((i + 1, i, -1.0));
+            }
+        }
+        SymmetricCsr::from_triplets(n, &t)
+    }
+
+    #[test]
+    fn solves_a_known_system() {
+        // A x = b with x_i = sin(i) + 1; residual relative to ‖b‖ at round-off level: the
+        // condition number of the 200-point Laplacian is ≈ 1.6e4, so the error ≲ 1e4 · 1e-16.
+        let n = 200;
+        let a = laplacian(n);
+        let x: Vec<f64> = (0..n).map(|i| (i as f64).sin() + 1.0).collect();
+        let mut b = vec![0.0; n];
+        a.mul_vec(&x, &mut b);
+        let llt = SparseCholesky::new(&a).unwrap();
+        assert_eq!(llt.dim(), n);
+        assert!(llt.factor_nnz() >= 2 * n - 1);
+        let mut ws = llt.solve_scratch();
+        let mut sol = b.clone();
+        llt.solve_in_place(&mut sol, &mut ws);
+        let err = x
+            .iter()
+            .zip(&sol)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-10, "max error {err}");
+    }
+
+    #[test]
+    fn refactor_reuses_the_pattern() {
+        let n = 50;
+        let a = laplacian(n);
+        let mut llt = SparseCholesky::new(&a).unwrap();
+        // 2A: the solution halves.
+        let mut a2 = a.clone();
+        a2.values.iter_mut().for_each(|v| *v *= 2.0);
+        llt.refactor(&a2).unwrap();
+        let x = vec![1.0; n];
+        let mut b = vec![0.0; n];
+        a2.mul_vec(&x, &mut b);
+        let mut ws = llt.solve_scratch();
+        llt.solve_in_place(&mut b, &mut ws);
+        assert!(b.iter().all(|v| (v - 1.0).abs() < 1e-12));
+        // A different pattern is rejected.
+        let e = llt.refactor(&SymmetricCsr::from_triplets(
+            n,
+            &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>(),
+        ));
+        assert!(e.unwrap_err().message.contains("pattern"));
+    }
+
+    #[test]
+    fn reports_a_non_positive_definite_matrix() {
+        // tridiag(−1, 2, −1) − 3 I has negative eigenvalues; a zero matrix is singular.
+        let mut a = laplacian(10);
+        for i in 0..10 {
+            let (cols, _) = a.row(i);
+            let k = a.row_ptr[i] + cols.binary_search(&i).unwrap();
+            a.values[k] -= 3.0;
+        }
+        let e = SparseCholesky::new(&a)
+            .err()
+            .expect("indefinite matrix must be rejected");
+        assert!(e.message.contains("not positive definite"), "{}", e.message);
+        let singular =
+            SymmetricCsr::from_triplets(2, &[(0, 0, 1.0), (0, 1, 1.0), (1, 0, 1.0), (1, 1, 1.0)]);
+        assert!(SparseCholesky::new(&singular).is_err());
     }
 }
