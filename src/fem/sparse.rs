@@ -71,23 +71,6 @@ impl SymmetricCsr {
         }
     }
 
-    /// Rows/cols `keep`, in that order.
-    pub fn submatrix(&self, keep: &[usize]) -> SymmetricCsr {
-        let _ = keep;
-        todo!()
-    }
-
-    /// `A ⊗ I3`.
-    pub fn kron_i3(&self) -> SymmetricCsr {
-        todo!()
-    }
-
-    /// `a A + b B` on the union pattern.
-    pub fn linear_combination(a: f64, m: &SymmetricCsr, b: f64, k: &SymmetricCsr) -> SymmetricCsr {
-        let _ = (a, m, b, k);
-        todo!()
-    }
-
     /// Number of stored entries (both triangles).
     pub fn nnz(&self) -> usize {
         self.values.len()
