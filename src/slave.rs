@@ -65,15 +65,14 @@ impl Parameters {
     }
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
-    /// placement and the iteration settings).
-    fn model_key(&self) -> (IsotropicMaterial, [u64; 4], bool) {
+    /// placement, the step size and the iteration settings).
+    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool) {
         (
             self.material,
             [
                 self.damping_alpha.to_bits(),
                 self.damping_beta.to_bits(),
                 self.rho_inf.to_bits(),
-                self.step_size.to_bits(),
             ],
             self.nonlinear_forces,
         )
@@ -114,7 +113,7 @@ struct Interface {
 
 /// The assembled model for one set of parameters.
 struct Model {
-    key: (IsotropicMaterial, [u64; 4], bool),
+    key: (IsotropicMaterial, [u64; 3], bool),
     body: Body,
     free: FreeNodes,
     scheme: GeneralizedAlpha,
