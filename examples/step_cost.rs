@@ -72,11 +72,11 @@ fn main() {
             "h = {h:e}: DOF {dof} (free {}), nnz(K) {nnz_k}, nnz(L) {}, init {:.3} s, solve {:.3} ms, step {:.3} ms ({:.0} steps/s), {:.2} iterations/step, step/solve {:.2}",
             free.dof_count(),
             matrix.factor.factor_nnz(),
-            iterations as f64 / internal_steps as f64,
             init,
             1e3 * solve,
             1e3 * step,
             1.0 / step,
+            iterations as f64 / internal_steps as f64,
             step / solve
         );
     }
