@@ -54,7 +54,7 @@ impl Mesh {
         if connectivity.is_empty() {
             return Err(Error::new("mesh: no elements"));
         }
-        if connectivity.len() % per_element != 0 {
+        if !connectivity.len().is_multiple_of(per_element) {
             return Err(Error::new(format!(
                 "mesh: connectivity length {} is not a multiple of {per_element} ({kind:?} nodes per element)",
                 connectivity.len()
