@@ -263,3 +263,20 @@ mod tests {
         assert!(e.message.contains("not a multiple of 20"), "{}", e.message);
     }
 }
+
+#[cfg(test)]
+mod hex20_tests {
+    use super::*;
+
+    #[test]
+    fn folded_hex20_edge_is_rejected() {
+        // Mid-edge node 8 of edge 0-1 pulled beyond corner 1: the map folds near node 1.
+        let base = generator::beam(1.0, 1.0, 1.0, [1, 1, 1], ElementKind::Hex20).unwrap();
+        let mut nodes = base.nodes().to_vec();
+        let mid = base.element(0)[8];
+        nodes[mid][0] = 1.3;
+        let conn = base.element(0).to_vec();
+        let e = Mesh::new(nodes, ElementKind::Hex20, conn).unwrap_err();
+        assert!(e.message.contains("element 0 is inverted"), "{}", e.message);
+    }
+}
