@@ -273,8 +273,8 @@ pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
             );
             let w = density * reference.weights[q] * det;
             element_mass += w;
-            for a in 0..n {
-                diagonal[a] += w * reference.values[q][a] * reference.values[q][a];
+            for (diag, &value) in diagonal[..n].iter_mut().zip(&reference.values[q][..n]) {
+                *diag += w * value * value;
             }
         }
         let scale = element_mass / diagonal[..n].iter().sum::<f64>();
@@ -286,6 +286,7 @@ pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
     use crate::fem::element::{natural_coordinates, HEX_EDGES};

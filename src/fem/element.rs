@@ -223,6 +223,7 @@ pub fn physical_gradients(
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
 

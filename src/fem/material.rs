@@ -75,6 +75,7 @@ impl IsotropicMaterial {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
 

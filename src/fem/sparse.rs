@@ -112,8 +112,8 @@ impl SymmetricCsr {
         }
         let mut row_ptr = Vec::with_capacity(keep.len() + 1);
         row_ptr.push(0);
-        let mut col_idx = Vec::new();
-        let mut values = Vec::new();
+        let mut col_idx = Vec::with_capacity(self.nnz());
+        let mut values = Vec::with_capacity(self.nnz());
         let mut row_entries: Vec<(usize, f64)> = Vec::new();
         for &old in keep {
             row_entries.clear();
@@ -123,7 +123,10 @@ impl SymmetricCsr {
                     row_entries.push((new_index[c], v));
                 }
             }
-            row_entries.sort_unstable_by_key(|e| e.0);
+            // Already ordered when `keep` is ascending (the usual free-DOF list).
+            if !row_entries.is_sorted_by_key(|e| e.0) {
+                row_entries.sort_unstable_by_key(|e| e.0);
+            }
             for &(c, v) in &row_entries {
                 col_idx.push(c);
                 values.push(v);

@@ -54,7 +54,7 @@ impl Mesh {
         if connectivity.is_empty() {
             return Err(Error::new("mesh: no elements"));
         }
-        if connectivity.len() % per_element != 0 {
+        if !connectivity.len().is_multiple_of(per_element) {
             return Err(Error::new(format!(
                 "mesh: connectivity length {} is not a multiple of {per_element} ({kind:?} nodes per element)",
                 connectivity.len()
@@ -261,5 +261,22 @@ mod tests {
         assert!(e.message.contains("node 8 is not used"), "{}", e.message);
         let e = Mesh::new(cube(), ElementKind::Hex20, (0..8).collect()).unwrap_err();
         assert!(e.message.contains("not a multiple of 20"), "{}", e.message);
+    }
+}
+
+#[cfg(test)]
+mod hex20_tests {
+    use super::*;
+
+    #[test]
+    fn folded_hex20_edge_is_rejected() {
+        // Mid-edge node 8 of edge 0-1 pulled beyond corner 1: the map folds near node 1.
+        let base = generator::beam(1.0, 1.0, 1.0, [1, 1, 1], ElementKind::Hex20).unwrap();
+        let mut nodes = base.nodes().to_vec();
+        let mid = base.element(0)[8];
+        nodes[mid][0] = 1.3;
+        let conn = base.element(0).to_vec();
+        let e = Mesh::new(nodes, ElementKind::Hex20, conn).unwrap_err();
+        assert!(e.message.contains("element 0 is inverted"), "{}", e.message);
     }
 }

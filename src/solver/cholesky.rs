@@ -36,7 +36,10 @@ pub struct SolveWorkspace {
 
 impl SparseCholesky {
     /// Symbolic analysis of the pattern of `matrix` (its lower triangle is used) and the numeric
-    /// factorization of its values. Error if the matrix is not positive definite.
+    /// factorization of its values. Error if the matrix is not positive definite, i.e. if a pivot
+    /// is not positive. A singular matrix (e.g. the stiffness of an unsupported body) usually
+    /// produces such a pivot, but round-off may leave a tiny positive one instead: supports are to
+    /// be checked where they are defined, not inferred from this factorization.
     pub fn new(matrix: &SymmetricCsr) -> Result<SparseCholesky> {
         let n = matrix.n;
         let mut lower_col_ptr = Vec::with_capacity(n + 1);
