@@ -1,1 +1,229 @@
-fn main() {}
+//! The project's tasks, run as `cargo xtask <task>` (alias in `.cargo/config.toml`):
+//!
+//! * `fmu [--body FILE] [--out FILE]`: builds the release library and the description binary and
+//!   packages `modelDescription.xml`, `binaries/<platform>/<modelIdentifier>.<ext>` and
+//!   `resources/body.json` into an FMI 2.0 `.fmu` (default: `<target>/fmu/<body name>.fmu`).
+//! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), then the
+//!   default FMU, the pinned Python environment (`<target>/venv`) and `pytest tests/python` with
+//!   the FMU's path in `FLEXBODY_FMU`.
+//! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
+//!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
+//!
+//! Only `std::process::Command` and the zip crate: no shell, no build scripts of our own.
+
+mod fmu;
+mod venv;
+
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+
+/// Errors of a task: a message for the terminal.
+pub type Result<T> = std::result::Result<T, String>;
+
+const USAGE: &str = "\
+usage: cargo xtask <task>
+
+tasks:
+  fmu [--body FILE] [--out FILE]    build the .fmu (default body: examples/cantilever.json,
+                                    default out: <target>/fmu/<body name>.fmu)
+  test [--python-only] [ARGS...]    cargo test --workspace, build the default .fmu, set up the
+                                    pinned venv (<target>/venv) and run pytest tests/python
+                                    (ARGS go to pytest; --python-only skips the Rust tests)
+  demo                              simulate the default cantilever with fmpy, print a table,
+                                    compare with the Timoshenko deflection, plot to
+                                    <target>/demo/cantilever.png";
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let (task, rest) = match args.split_first() {
+        Some((task, rest)) => (task.as_str(), rest),
+        None => {
+            eprintln!("{USAGE}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let result = match task {
+        "fmu" => fmu_task(rest),
+        "test" => test_task(rest),
+        "demo" => demo_task(rest),
+        "-h" | "--help" | "help" => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        other => Err(format!("unknown task '{other}'\n{USAGE}")),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("xtask {task}: error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `cargo xtask fmu [--body FILE] [--out FILE]`.
+fn fmu_task(args: &[String]) -> Result<()> {
+    let mut body = None;
+    let mut out = None;
+    let mut args = args.iter();
+    while let Some(arg) = args.next() {
+        let slot = match arg.as_str() {
+            "--body" => &mut body,
+            "--out" => &mut out,
+            other => return Err(format!("unexpected argument '{other}'\n{USAGE}")),
+        };
+        let value = args
+            .next()
+            .ok_or_else(|| format!("{arg} needs a file name"))?;
+        // Relative paths are relative to where the user typed the command.
+        *slot = Some(std::path::absolute(value).map_err(|e| format!("{value}: {e}"))?);
+    }
+    let workspace = Workspace::locate()?;
+    workspace.build_fmu(body.as_deref(), out.as_deref())?;
+    Ok(())
+}
+
+/// `cargo xtask test [--python-only] [PYTEST ARGS...]`.
+fn test_task(args: &[String]) -> Result<()> {
+    let python_only = args.iter().any(|a| a == "--python-only");
+    let pytest_args: Vec<&String> = args.iter().filter(|a| *a != "--python-only").collect();
+    let workspace = Workspace::locate()?;
+    if !python_only {
+        println!("xtask test: Rust tests (cargo test --workspace)");
+        run(workspace.cargo().args(["test", "--workspace"]))?;
+    }
+    let fmu = workspace.build_fmu(None, None)?;
+    let python = venv::ensure(&workspace)?;
+    println!(
+        "xtask test: Python tests (pytest tests/python) on {}",
+        fmu.display()
+    );
+    let mut pytest = Command::new(&python);
+    pytest
+        .current_dir(&workspace.root)
+        .args(["-m", "pytest", "tests/python"])
+        .args(pytest_args)
+        .env("FLEXBODY_FMU", &fmu)
+        .env("MPLBACKEND", "Agg");
+    run(&mut pytest)
+}
+
+/// `cargo xtask demo`.
+fn demo_task(args: &[String]) -> Result<()> {
+    if let Some(arg) = args.first() {
+        return Err(format!("unexpected argument '{arg}'\n{USAGE}"));
+    }
+    let workspace = Workspace::locate()?;
+    let fmu = workspace.build_fmu(None, None)?;
+    let python = venv::ensure(&workspace)?;
+    let plot = workspace.target_dir.join("demo").join("cantilever.png");
+    let mut demo = Command::new(&python);
+    demo.current_dir(&workspace.root)
+        .arg("tests/python/demo.py")
+        .arg("--fmu")
+        .arg(&fmu)
+        .arg("--plot")
+        .arg(&plot)
+        .env("MPLBACKEND", "Agg");
+    run(&mut demo)
+}
+
+/// Where things are: the workspace root (sources) and cargo's target directory (outputs).
+pub struct Workspace {
+    pub root: PathBuf,
+    /// Cargo's target directory: honours `CARGO_TARGET_DIR` and `build.target-dir`.
+    pub target_dir: PathBuf,
+    cargo: OsString,
+}
+
+impl Workspace {
+    /// Finds the workspace (the parent of this crate) and asks cargo for its target directory.
+    fn locate() -> Result<Workspace> {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .parent()
+            .ok_or("xtask has no parent directory")?
+            .to_path_buf();
+        // `cargo run` tells the program which cargo started it.
+        let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let metadata = output(Command::new(&cargo).current_dir(&root).args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--no-deps",
+        ]))?;
+        let metadata: serde_json::Value =
+            serde_json::from_str(&metadata).map_err(|e| format!("cargo metadata: {e}"))?;
+        let target_dir = metadata["target_directory"]
+            .as_str()
+            .ok_or("cargo metadata has no target_directory")?
+            .into();
+        Ok(Workspace {
+            root,
+            target_dir,
+            cargo,
+        })
+    }
+
+    /// A `cargo` command run in the workspace root.
+    pub fn cargo(&self) -> Command {
+        let mut command = Command::new(&self.cargo);
+        command.current_dir(&self.root);
+        command
+    }
+
+    /// The default body file (also embedded in the library).
+    pub fn default_body(&self) -> PathBuf {
+        self.root.join("examples").join("cantilever.json")
+    }
+
+    /// Builds and packages the FMU; returns its path.
+    fn build_fmu(&self, body: Option<&Path>, out: Option<&Path>) -> Result<PathBuf> {
+        let body = body.map_or_else(|| self.default_body(), Path::to_path_buf);
+        let artifacts = fmu::build_release(self)?;
+        let package = fmu::package(self, &artifacts, &body, out)?;
+        let size = std::fs::metadata(&package)
+            .map_err(|e| format!("{}: {e}", package.display()))?
+            .len();
+        println!(
+            "xtask fmu: wrote {} ({:.1} MiB, {size} bytes)",
+            package.display(),
+            size as f64 / (1024.0 * 1024.0)
+        );
+        Ok(package)
+    }
+}
+
+/// Runs a command with inherited standard streams; an error if it fails.
+pub fn run(command: &mut Command) -> Result<()> {
+    let status = command
+        .status()
+        .map_err(|e| format!("cannot run {}: {e}", describe(command)))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{} failed ({status})", describe(command)))
+    }
+}
+
+/// Runs a command and returns its standard output (standard error goes to the terminal).
+pub fn output(command: &mut Command) -> Result<String> {
+    let result = command
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", describe(command)))?;
+    if !result.status.success() {
+        return Err(format!("{} failed ({})", describe(command), result.status));
+    }
+    String::from_utf8(result.stdout)
+        .map_err(|e| format!("{}: output is not UTF-8: {e}", describe(command)))
+}
+
+/// The command line, for messages.
+fn describe(command: &Command) -> String {
+    std::iter::once(command.get_program())
+        .chain(command.get_args())
+        .map(|s| s.to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join(" ")
+}

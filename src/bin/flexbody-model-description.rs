@@ -1,0 +1,109 @@
+//! Prints the complete FMI 2.0 `modelDescription.xml` of a body to standard output.
+//!
+//! Usage: `flexbody-model-description [--body FILE]`. Without `--body` it describes the embedded
+//! default body (`examples/cantilever.json`). `cargo xtask fmu` runs it to build the `.fmu`, so
+//! the XML comes from the same code (and the same GUID) as the binary that reads it.
+//! On any error the message goes to standard error and the exit code is 1.
+
+use flexbody::model::BodyFile;
+use flexbody::slave::Slave;
+use std::process::ExitCode;
+
+const USAGE: &str = "usage: flexbody-model-description [--body FILE]";
+
+/// What the command line asks for.
+#[derive(Debug, PartialEq)]
+enum Command {
+    /// Describe the body in this file, or the embedded default body (`None`).
+    Describe {
+        body: Option<String>,
+    },
+    Help,
+}
+
+/// Parses the arguments after the program name.
+fn parse_args(args: impl IntoIterator<Item = String>) -> Result<Command, String> {
+    let mut body = None;
+    let mut args = args.into_iter();
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
+            "--body" => {
+                let file = args.next().ok_or("--body needs a file name")?;
+                if body.replace(file).is_some() {
+                    return Err("--body given twice".into());
+                }
+            }
+            "-h" | "--help" => return Ok(Command::Help),
+            other => return Err(format!("unexpected argument '{other}'")),
+        }
+    }
+    Ok(Command::Describe { body })
+}
+
+/// The modelDescription.xml of the body in `file` (or of the default body).
+fn describe(file: Option<&str>) -> Result<String, String> {
+    let body = match file {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).map_err(|e| format!("cannot read {path}: {e}"))?;
+            BodyFile::from_json(&text).map_err(|e| format!("{path}: {e}"))?
+        }
+        None => BodyFile::default_body(),
+    };
+    let slave = Slave::from_body(body).map_err(|e| e.to_string())?;
+    Ok(slave.model_description())
+}
+
+fn main() -> ExitCode {
+    let result = parse_args(std::env::args().skip(1)).and_then(|command| match command {
+        Command::Help => {
+            println!("{USAGE}");
+            Ok(())
+        }
+        Command::Describe { body } => describe(body.as_deref()).map(|xml| print!("{xml}")),
+    });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("flexbody-model-description: {message}\n{USAGE}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn args(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn no_arguments_describe_the_default_body() {
+        assert_eq!(parse_args(args(&[])), Ok(Command::Describe { body: None }));
+    }
+
+    #[test]
+    fn body_option_takes_a_file() {
+        assert_eq!(
+            parse_args(args(&["--body", "beam.json"])),
+            Ok(Command::Describe {
+                body: Some("beam.json".into())
+            })
+        );
+    }
+
+    #[test]
+    fn bad_arguments_are_rejected() {
+        assert!(parse_args(args(&["--body"])).is_err());
+        assert!(parse_args(args(&["--body", "a.json", "--body", "b.json"])).is_err());
+        assert!(parse_args(args(&["beam.json"])).is_err());
+    }
+
+    #[test]
+    fn unreadable_body_file_is_an_error_naming_it() {
+        let err = describe(Some("/nonexistent/body.json")).unwrap_err();
+        assert!(err.contains("/nonexistent/body.json"), "{err}");
+    }
+}

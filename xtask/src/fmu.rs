@@ -1,0 +1,324 @@
+//! Building and packaging the `.fmu`: a zip archive (FMI 2.0 section 2.3) with
+//!
+//! ```text
+//! modelDescription.xml                           from `flexbody-model-description --body FILE`
+//! binaries/<platform>/<modelIdentifier>.<ext>    the release cdylib, renamed (linux64: .so)
+//! resources/body.json                            the body file, byte for byte
+//! ```
+//!
+//! The shared library's name is taken from the `modelIdentifier` attribute of the generated XML,
+//! so the archive cannot disagree with its own description.
+
+use crate::{Result, Workspace};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use zip::write::SimpleFileOptions;
+use zip::{CompressionMethod, ZipWriter};
+
+/// The package and binary names the build produces.
+const LIBRARY_PACKAGE: &str = "flexbody";
+const DESCRIPTION_BINARY: &str = "flexbody-model-description";
+
+/// The release artifacts an FMU is made of.
+pub struct Artifacts {
+    /// The cdylib (`libflexbody.so` on Linux).
+    pub library: PathBuf,
+    /// The `flexbody-model-description` executable.
+    pub description_binary: PathBuf,
+}
+
+/// `cargo build --release -p flexbody --lib --bins`; finds the artifacts in cargo's JSON messages
+/// (so `CARGO_TARGET_DIR`, `build.target-dir` and cross targets need no guessing).
+pub fn build_release(workspace: &Workspace) -> Result<Artifacts> {
+    println!("xtask fmu: cargo build --release -p {LIBRARY_PACKAGE} --lib --bins");
+    let messages = crate::output(workspace.cargo().args([
+        "build",
+        "--release",
+        "-p",
+        LIBRARY_PACKAGE,
+        "--lib",
+        "--bins",
+        "--message-format=json-render-diagnostics",
+    ]))?;
+    artifacts_from_messages(&messages)
+}
+
+/// Picks the cdylib and the description binary out of cargo's `compiler-artifact` messages.
+fn artifacts_from_messages(messages: &str) -> Result<Artifacts> {
+    let mut library = None;
+    let mut description_binary = None;
+    for line in messages.lines().filter(|l| l.starts_with('{')) {
+        let message: serde_json::Value =
+            serde_json::from_str(line).map_err(|e| format!("cargo message {line}: {e}"))?;
+        if message["reason"] != "compiler-artifact" {
+            continue;
+        }
+        let target = &message["target"];
+        let kinds = target["kind"].as_array().cloned().unwrap_or_default();
+        let is_kind = |kind: &str| kinds.iter().any(|k| k == kind);
+        if target["name"] == LIBRARY_PACKAGE && is_kind("cdylib") {
+            let suffix = std::env::consts::DLL_SUFFIX;
+            library = message["filenames"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|f| f.as_str())
+                .find(|f| f.ends_with(suffix))
+                .map(PathBuf::from);
+        } else if target["name"] == DESCRIPTION_BINARY && is_kind("bin") {
+            description_binary = message["executable"].as_str().map(PathBuf::from);
+        }
+    }
+    Ok(Artifacts {
+        library: library.ok_or("cargo reported no cdylib for flexbody")?,
+        description_binary: description_binary
+            .ok_or_else(|| format!("cargo reported no executable {DESCRIPTION_BINARY}"))?,
+    })
+}
+
+/// Generates the description for `body` and writes the `.fmu`; returns its path.
+pub fn package(
+    workspace: &Workspace,
+    artifacts: &Artifacts,
+    body: &Path,
+    out: Option<&Path>,
+) -> Result<PathBuf> {
+    let body_text = std::fs::read_to_string(body)
+        .map_err(|e| format!("cannot read {}: {e}", body.display()))?;
+    let xml = crate::output(
+        std::process::Command::new(&artifacts.description_binary)
+            .arg("--body")
+            .arg(body),
+    )?;
+    let model_identifier = model_identifier(&xml)?;
+    let out = match out {
+        Some(path) => path.to_path_buf(),
+        None => workspace
+            .target_dir
+            .join("fmu")
+            .join(format!("{}.fmu", file_stem(&body_name(&body_text)?))),
+    };
+    write_fmu(
+        &out,
+        &xml,
+        &model_identifier,
+        &artifacts.library,
+        body_text.as_bytes(),
+    )?;
+    Ok(out)
+}
+
+/// The FMI platform folder and library extension of the machine this xtask was built for.
+fn platform() -> Result<(&'static str, &'static str)> {
+    if cfg!(not(target_pointer_width = "64")) {
+        return Err("only 64-bit platforms are packaged".into());
+    }
+    match std::env::consts::OS {
+        "linux" => Ok(("linux64", "so")),
+        "macos" => Ok(("darwin64", "dylib")),
+        "windows" => Ok(("win64", "dll")),
+        os => Err(format!("FMI 2.0 defines no binaries folder for {os}")),
+    }
+}
+
+/// Writes the archive next to `out` and renames it into place, so a failed run leaves no
+/// half-written `.fmu`.
+fn write_fmu(
+    out: &Path,
+    xml: &str,
+    model_identifier: &str,
+    library: &Path,
+    body_json: &[u8],
+) -> Result<()> {
+    let (platform, extension) = platform()?;
+    let library_bytes =
+        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    if let Some(dir) = out.parent() {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    }
+    let partial = out.with_extension("fmu.partial");
+    let entries: [(String, &[u8], u32); 3] = [
+        ("modelDescription.xml".into(), xml.as_bytes(), 0o644),
+        (
+            format!("binaries/{platform}/{model_identifier}.{extension}"),
+            &library_bytes,
+            0o755,
+        ),
+        ("resources/body.json".into(), body_json, 0o644),
+    ];
+    let write = || -> std::io::Result<()> {
+        let mut zip = ZipWriter::new(BufWriter::new(File::create(&partial)?));
+        for (name, bytes, mode) in entries {
+            let options = SimpleFileOptions::default()
+                .compression_method(CompressionMethod::Deflated)
+                .unix_permissions(mode);
+            zip.start_file(name, options)?;
+            zip.write_all(bytes)?;
+        }
+        zip.finish()?.flush()
+    };
+    write().map_err(|e| format!("cannot write {}: {e}", partial.display()))?;
+    std::fs::rename(&partial, out).map_err(|e| {
+        format!(
+            "cannot move {} to {}: {e}",
+            partial.display(),
+            out.display()
+        )
+    })
+}
+
+/// The `modelIdentifier` attribute of the `<CoSimulation>` element.
+fn model_identifier(xml: &str) -> Result<String> {
+    let key = "modelIdentifier=\"";
+    let start = xml
+        .find(key)
+        .ok_or("modelDescription.xml has no modelIdentifier")?
+        + key.len();
+    let length = xml[start..]
+        .find('"')
+        .ok_or("modelDescription.xml: unterminated modelIdentifier")?;
+    let identifier = &xml[start..start + length];
+    let valid = identifier
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && identifier
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_');
+    if valid {
+        Ok(identifier.to_string())
+    } else {
+        Err(format!(
+            "modelIdentifier '{identifier}' is not a C identifier"
+        ))
+    }
+}
+
+/// The body file's `name`.
+fn body_name(body_json: &str) -> Result<String> {
+    let body: serde_json::Value =
+        serde_json::from_str(body_json).map_err(|e| format!("body file: {e}"))?;
+    body["name"]
+        .as_str()
+        .map(str::to_string)
+        .ok_or_else(|| "body file has no \"name\"".into())
+}
+
+/// A file name made from a model name: characters other than letters, digits, `-`, `_` and `.`
+/// become `_`.
+fn file_stem(name: &str) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() || stem.chars().all(|c| c == '.') {
+        "body".into()
+    } else {
+        stem
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Read;
+
+    #[test]
+    fn model_identifier_is_read_from_the_cosimulation_element() {
+        let xml = r#"<fmiModelDescription fmiVersion="2.0" modelName="cantilever">
+            <CoSimulation modelIdentifier="flexbody" canHandleVariableCommunicationStepSize="true"/>"#;
+        assert_eq!(model_identifier(xml).unwrap(), "flexbody");
+        assert!(model_identifier("<fmiModelDescription/>").is_err());
+        assert!(model_identifier(r#"<CoSimulation modelIdentifier="../evil"/>"#).is_err());
+    }
+
+    #[test]
+    fn file_stem_keeps_safe_characters_only() {
+        assert_eq!(file_stem("cantilever"), "cantilever");
+        assert_eq!(file_stem("robot arm/link 2"), "robot_arm_link_2");
+        assert_eq!(file_stem(".."), "body");
+        assert_eq!(file_stem(""), "body");
+    }
+
+    #[test]
+    fn body_name_comes_from_the_body_file() {
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../examples/cantilever.json"
+        ))
+        .unwrap();
+        assert_eq!(body_name(&text).unwrap(), "cantilever");
+        assert!(body_name("{}").is_err());
+    }
+
+    #[test]
+    fn artifacts_are_found_in_cargo_messages() {
+        let messages = r#"
+{"reason":"compiler-artifact","target":{"kind":["lib"],"name":"serde"},"filenames":["/t/release/deps/libserde.rlib"],"executable":null}
+{"reason":"compiler-artifact","target":{"kind":["cdylib","rlib"],"name":"flexbody"},"filenames":["/t/release/libflexbody.so","/t/release/libflexbody.rlib"],"executable":null}
+{"reason":"compiler-artifact","target":{"kind":["bin"],"name":"flexbody-model-description"},"filenames":["/t/release/flexbody-model-description"],"executable":"/t/release/flexbody-model-description"}
+{"reason":"build-finished","success":true}
+"#;
+        let artifacts = artifacts_from_messages(messages).unwrap();
+        if cfg!(target_os = "linux") {
+            assert_eq!(artifacts.library, Path::new("/t/release/libflexbody.so"));
+        }
+        assert_eq!(
+            artifacts.description_binary,
+            Path::new("/t/release/flexbody-model-description")
+        );
+        assert!(artifacts_from_messages(r#"{"reason":"build-finished","success":true}"#).is_err());
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn fmu_has_the_fmi_layout() {
+        let dir = std::env::temp_dir().join(format!("xtask-fmu-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let library = dir.join("libflexbody.so");
+        std::fs::write(&library, b"\x7fELF not really").unwrap();
+        let out = dir.join("out").join("cantilever.fmu");
+        let xml = r#"<fmiModelDescription><CoSimulation modelIdentifier="flexbody"/></fmiModelDescription>"#;
+        write_fmu(
+            &out,
+            xml,
+            "flexbody",
+            &library,
+            b"{\"name\":\"cantilever\"}",
+        )
+        .unwrap();
+        assert!(!out.with_extension("fmu.partial").exists());
+
+        let mut archive = zip::ZipArchive::new(File::open(&out).unwrap()).unwrap();
+        let mut names: Vec<String> = archive.file_names().map(str::to_string).collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "binaries/linux64/flexbody.so",
+                "modelDescription.xml",
+                "resources/body.json"
+            ]
+        );
+        let mut read = |name: &str| {
+            let mut entry = archive.by_name(name).unwrap();
+            let mut bytes = Vec::new();
+            entry.read_to_end(&mut bytes).unwrap();
+            (bytes, entry.unix_mode())
+        };
+        assert_eq!(read("modelDescription.xml").0, xml.as_bytes());
+        let (library_bytes, mode) = read("binaries/linux64/flexbody.so");
+        assert_eq!(library_bytes, b"\x7fELF not really");
+        assert_eq!(mode.map(|m| m & 0o777), Some(0o755));
+        assert_eq!(read("resources/body.json").0, b"{\"name\":\"cantilever\"}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

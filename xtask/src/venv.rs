@@ -1,0 +1,125 @@
+//! The pinned Python environment of the fmpy tests and the demo: `<target>/venv`, made with
+//! `python3 -m venv` and filled from `tests/python/requirements.txt` with every transitive
+//! dependency pinned by `tests/python/constraints.txt`.
+//!
+//! A stamp file in the venv holds the interpreter's version and both files' text; the venv is
+//! reused while the stamp matches and rebuilt from scratch when it does not (or when an
+//! installation was interrupted, which leaves no stamp).
+
+use crate::{run, Result, Workspace};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const STAMP: &str = "flexbody-requirements.stamp";
+
+/// Returns the venv's Python interpreter, creating or rebuilding the venv when needed.
+/// The base interpreter is `$FLEXBODY_PYTHON`, else `python3`.
+pub fn ensure(workspace: &Workspace) -> Result<PathBuf> {
+    let base_python = std::env::var_os("FLEXBODY_PYTHON").unwrap_or_else(|| "python3".into());
+    let requirements = workspace.root.join("tests/python/requirements.txt");
+    let constraints = workspace.root.join("tests/python/constraints.txt");
+    let version = crate::output(Command::new(&base_python).arg("--version"))?;
+    let wanted = stamp_text(&version, &read(&requirements)?, &read(&constraints)?);
+
+    let venv = workspace.target_dir.join("venv");
+    let python = venv_python(&venv);
+    let stamp = venv.join(STAMP);
+    if python.exists() && std::fs::read_to_string(&stamp).ok().as_deref() == Some(wanted.as_str()) {
+        println!("xtask: reusing {}", venv.display());
+        return Ok(python);
+    }
+
+    println!("xtask: creating {} ({})", venv.display(), version.trim());
+    if venv.exists() {
+        std::fs::remove_dir_all(&venv)
+            .map_err(|e| format!("cannot remove {}: {e}", venv.display()))?;
+    }
+    run(Command::new(&base_python).args(["-m", "venv"]).arg(&venv))?;
+    run(Command::new(&python)
+        .args([
+            "-m",
+            "pip",
+            "install",
+            "--disable-pip-version-check",
+            "--no-input",
+            "-r",
+        ])
+        .arg(&requirements)
+        .arg("-c")
+        .arg(&constraints))?;
+    std::fs::write(&stamp, wanted).map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
+    Ok(python)
+}
+
+/// What the venv was built from.
+fn stamp_text(python_version: &str, requirements: &str, constraints: &str) -> String {
+    format!(
+        "{}\n--- requirements.txt\n{requirements}\n--- constraints.txt\n{constraints}",
+        python_version.trim()
+    )
+}
+
+fn read(path: &Path) -> Result<String> {
+    std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+}
+
+/// The interpreter inside a venv.
+fn venv_python(venv: &Path) -> PathBuf {
+    if cfg!(windows) {
+        venv.join("Scripts").join("python.exe")
+    } else {
+        venv.join("bin").join("python")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stamp_changes_with_every_input() {
+        let base = stamp_text("Python 3.11.7\n", "fmpy==0.3.32\n", "numpy==2.4.6\n");
+        assert_eq!(
+            base,
+            stamp_text("Python 3.11.7", "fmpy==0.3.32\n", "numpy==2.4.6\n")
+        );
+        assert_ne!(
+            base,
+            stamp_text("Python 3.12.1", "fmpy==0.3.32\n", "numpy==2.4.6\n")
+        );
+        assert_ne!(
+            base,
+            stamp_text("Python 3.11.7", "fmpy==0.3.31\n", "numpy==2.4.6\n")
+        );
+        assert_ne!(
+            base,
+            stamp_text("Python 3.11.7", "fmpy==0.3.32\n", "numpy==2.4.5\n")
+        );
+    }
+
+    #[test]
+    fn pinned_files_pin_every_line() {
+        // Every requirement is `name==version`: an unpinned line would make the venv drift.
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/python");
+        for file in ["requirements.txt", "constraints.txt"] {
+            let text = read(&dir.join(file)).unwrap();
+            let lines: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .filter(|l| !l.is_empty() && !l.starts_with('#'))
+                .collect();
+            assert!(!lines.is_empty(), "{file} is empty");
+            for line in lines {
+                let (name, version) = line
+                    .split_once("==")
+                    .unwrap_or_else(|| panic!("{file}: '{line}' is not pinned"));
+                assert!(
+                    !name.is_empty() && !version.is_empty() && !version.contains(['*', ',']),
+                    "{file}: '{line}'"
+                );
+            }
+        }
+        let requirements = read(&dir.join("requirements.txt")).unwrap();
+        assert!(requirements.lines().any(|l| l.trim() == "fmpy==0.3.32"));
+    }
+}
