@@ -3,28 +3,12 @@
 
 mod common;
 use common::*;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use stats_alloc::{Region, StatsAlloc, INSTRUMENTED_SYSTEM};
+use std::alloc::System;
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
+// Counts every allocation of this test binary (the `stats_alloc` crate: no `unsafe` of ours).
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
 #[test]
 fn do_step_does_not_allocate_after_the_first_step() {
@@ -47,7 +31,7 @@ fn do_step_does_not_allocate_after_the_first_step() {
     // two internal steps (another factorization allowed).
     s.do_step(0.0, h).unwrap();
     s.do_step(h, 2.0 * h).unwrap();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let region = Region::new(GLOBAL);
     let mut t = 3.0 * h;
     for k in 0..20 {
         let big = if k % 2 == 0 { h } else { 2.0 * h };
@@ -58,6 +42,10 @@ fn do_step_does_not_allocate_after_the_first_step() {
             s.get_real(vr).unwrap();
         }
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
-    assert_eq!(after - before, 0, "{} allocations in 20 steps", after - before);
+    let stats = region.change();
+    assert_eq!(
+        stats.allocations + stats.reallocations,
+        0,
+        "allocations in 20 steps: {stats:?}"
+    );
 }
