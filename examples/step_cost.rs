@@ -22,7 +22,10 @@ fn set(s: &mut Slave, name: &str, value: f64) {
 }
 
 fn main() {
-    let steps: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(2000);
+    let steps: usize = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(2000);
     let body_file = BodyFile::default_body();
     println!("body: {} ({})", body_file.name, body_file.description);
 

@@ -240,7 +240,9 @@ impl Slave {
             });
         }
         if clamped.iter().all(|&c| c) {
-            return Err(Error::new("body file: fixed supports hold every node: nothing can move"));
+            return Err(Error::new(
+                "body file: fixed supports hold every node: nothing can move",
+            ));
         }
         let (lo, hi) = mesh.bounding_box();
         let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
@@ -314,10 +316,14 @@ impl Slave {
         tolerance: Option<f64>,
     ) -> Result<()> {
         if !start_time.is_finite() {
-            return Err(Error::invalid_value("startTime", start_time, "not a finite number"));
+            return Err(Error::invalid_value(
+                "startTime",
+                start_time,
+                "not a finite number",
+            ));
         }
         if let Some(stop) = stop_time {
-            if !(stop >= start_time) {
+            if stop.is_nan() || stop < start_time {
                 return Err(Error::invalid_value(
                     "stopTime",
                     stop,
@@ -432,9 +438,9 @@ impl Slave {
     /// Start value of a parameter or input as written in the XML (full precision).
     fn start_value(&self, v: &Variable) -> String {
         match (v.ty, v.target) {
-            (VariableType::Boolean, Target::Fixed { key, .. }) => {
-                read_boolean(&self.defaults, key).unwrap_or(false).to_string()
-            }
+            (VariableType::Boolean, Target::Fixed { key, .. }) => read_boolean(&self.defaults, key)
+                .unwrap_or(false)
+                .to_string(),
             (VariableType::Integer, Target::Fixed { key, .. }) => {
                 read_integer(&self.defaults, key).unwrap_or(0).to_string()
             }
@@ -456,16 +462,22 @@ impl Slave {
     pub fn get_real(&mut self, vr: u32) -> Result<f64> {
         let (target, causality) = match self.variables.get(VariableType::Real, vr) {
             Some(v) => (v.target, v.causality),
-            None => return Err(Error::new(format!("no Real variable has value reference {vr}"))),
+            None => {
+                return Err(Error::new(format!(
+                    "no Real variable has value reference {vr}"
+                )))
+            }
         };
         let value = match target {
-            Target::Fixed { key, component } => match read_parameter(&self.parameters, key, component) {
-                Some(p) => p,
-                None => {
-                    self.ensure_outputs()?;
-                    self.outputs.body[body_output_slot(key) + component]
+            Target::Fixed { key, component } => {
+                match read_parameter(&self.parameters, key, component) {
+                    Some(p) => p,
+                    None => {
+                        self.ensure_outputs()?;
+                        self.outputs.body[body_output_slot(key) + component]
+                    }
                 }
-            },
+            }
             Target::Interface {
                 index,
                 quantity,
@@ -513,10 +525,15 @@ impl Slave {
                 if !value.is_finite() {
                     return Err(Error::invalid_value(&v.name, value, "not a finite number"));
                 }
-                if !matches!(quantity, InterfaceQuantity::Force | InterfaceQuantity::Torque)
-                    || self.interfaces[index].kind != InterfaceKind::Force
+                if !matches!(
+                    quantity,
+                    InterfaceQuantity::Force | InterfaceQuantity::Torque
+                ) || self.interfaces[index].kind != InterfaceKind::Force
                 {
-                    return Err(Error::new(format!("{} is an output and cannot be set", v.name)));
+                    return Err(Error::new(format!(
+                        "{} is an output and cannot be set",
+                        v.name
+                    )));
                 }
                 self.inputs[index][quantity.slot() as usize + component] = value;
             }
@@ -604,7 +621,9 @@ impl Slave {
                 &format!("does not match the FMU's time {t} (restore a state with fmi2SetFMUstate to go back)"),
             ));
         }
-        let substeps = ((big_h / self.parameters.step_size) * (1.0 - 1e-9)).ceil().max(1.0);
+        let substeps = ((big_h / self.parameters.step_size) * (1.0 - 1e-9))
+            .ceil()
+            .max(1.0);
         if substeps > 1e9 {
             return Err(Error::invalid_value(
                 "communicationStepSize",
@@ -627,7 +646,8 @@ impl Slave {
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
         let body = &model.body;
-        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        let loads =
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
         let mut result = Ok(());
         for _ in 0..substeps as usize {
             let r = generalized_alpha::step(
@@ -671,7 +691,11 @@ impl Slave {
                     e.message
                 );
                 Err(Error {
-                    kind: if kind == ErrorKind::Discard { ErrorKind::Discard } else { ErrorKind::Error },
+                    kind: if kind == ErrorKind::Discard {
+                        ErrorKind::Discard
+                    } else {
+                        ErrorKind::Error
+                    },
                     message,
                 })
             }
@@ -805,8 +829,15 @@ impl Slave {
         let gravity = Vector3::from(p.gravity);
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
-        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
-        generalized_alpha::initial_acceleration(body, &model.free, &loads, &mut state, &mut model.workspace)?;
+        let loads =
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        generalized_alpha::initial_acceleration(
+            body,
+            &model.free,
+            &loads,
+            &mut state,
+            &mut model.workspace,
+        )?;
         self.dynamics = Some(Dynamics {
             state,
             loads: self.inputs.clone(),
@@ -832,7 +863,8 @@ impl Slave {
         let gravity = Vector3::from(dynamics.gravity);
         let interfaces = &self.interfaces;
         let loads_in = &dynamics.loads;
-        let loads = |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, loads_in, &gravity, x, f);
+        let loads =
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, loads_in, &gravity, x, f);
         let kin = generalized_alpha::residual(body, state, &loads, &mut model.workspace);
         let residual = generalized_alpha::last_residual(&model.workspace);
 
@@ -880,11 +912,10 @@ impl Slave {
                 }
                 InterfaceKind::Force => {
                     out[0..6].copy_from_slice(&dynamics.loads[k]);
-                    let m: InterfaceMotion = interface.set.motion(
-                        &state.position,
-                        &state.velocity,
-                        &state.acceleration,
-                    );
+                    let m: InterfaceMotion =
+                        interface
+                            .set
+                            .motion(&state.position, &state.velocity, &state.acceleration);
                     out[6..9].copy_from_slice(m.position.as_slice());
                     for (j, value) in out[9..18].iter_mut().enumerate() {
                         *value = m.rotation[(j / 3, j % 3)];
@@ -897,9 +928,16 @@ impl Slave {
             }
         }
         let finite = self.outputs.body.iter().all(|x| x.is_finite())
-            && self.outputs.interfaces.iter().flatten().all(|x| x.is_finite());
+            && self
+                .outputs
+                .interfaces
+                .iter()
+                .flatten()
+                .all(|x| x.is_finite());
         if !finite {
-            return Err(Error::new("the outputs of the current state are not finite"));
+            return Err(Error::new(
+                "the outputs of the current state are not finite",
+            ));
         }
         self.outputs.valid = true;
         Ok(())

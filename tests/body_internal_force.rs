@@ -78,8 +78,14 @@ fn internal_force_is_the_gradient_of_the_strain_energy() {
     let linear = small_beam(BodyOptions::default());
     let mut fl = vec![0.0; x.len()];
     linear.internal_force(&x, &zero, &mut scratch, &mut fl);
-    let diff = f.iter().zip(&fl).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(diff > 1e3 * worst, "f_nl should matter at this deformation: {diff:e}");
+    let diff = f
+        .iter()
+        .zip(&fl)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        diff > 1e3 * worst,
+        "f_nl should matter at this deformation: {diff:e}"
+    );
 }
 
 #[test]
@@ -108,7 +114,11 @@ fn with_f_nl_the_internal_force_has_no_net_force_or_moment() {
     // f_nl (to round-off), without it it is of second order in the deformation.
     assert!(with.0 < 1e-13 && without.0 < 1e-13, "{with:?} {without:?}");
     assert!(with.1 < 1e-13, "net moment with f_nl: {:e}", with.1);
-    assert!(without.1 > 1e4 * with.1.max(1e-16), "net moment without f_nl: {:e}", without.1);
+    assert!(
+        without.1 > 1e4 * with.1.max(1e-16),
+        "net moment without f_nl: {:e}",
+        without.1
+    );
 }
 
 #[test]
@@ -131,17 +141,30 @@ fn damping_leaves_rigid_motion_of_a_deformed_body_undamped() {
     body.internal_force(&x, &v, &mut scratch, &mut fd);
     undamped.internal_force(&x, &v, &mut scratch, &mut f0);
     let scale = f0.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
-    let diff = fd.iter().zip(&f0).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-    assert!(diff < 1e-9 * scale, "damping force of a rigid motion: {diff:e} (scale {scale:e})");
+    let diff = fd
+        .iter()
+        .zip(&f0)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        diff < 1e-9 * scale,
+        "damping force of a rigid motion: {diff:e} (scale {scale:e})"
+    );
 
     // A deformation rate is damped: the damping force opposes it (negative power).
     let mut vd = v.clone();
     for i in 0..body.node_count() {
         let p = node(&body.reference, i);
-        set_node(&mut vd, i, &(node(&v, i) + Vector3::new(0.0, 0.05 * p.x * p.x, 0.0)));
+        set_node(
+            &mut vd,
+            i,
+            &(node(&v, i) + Vector3::new(0.0, 0.05 * p.x * p.x, 0.0)),
+        );
     }
     body.internal_force(&x, &vd, &mut scratch, &mut fd);
     undamped.internal_force(&x, &vd, &mut scratch, &mut f0);
     let power: f64 = (0..x.len()).map(|k| (fd[k] - f0[k]) * vd[k]).sum();
-    assert!(power > 0.0, "damping must dissipate: power of f_d = {power:e}");
+    assert!(
+        power > 0.0,
+        "damping must dissipate: power of f_d = {power:e}"
+    );
 }

@@ -16,7 +16,11 @@ fn damped_step_response_settles_at_the_static_deflection_and_the_support_balance
     }
     let deflection = get(&mut s, "tip.position[2]") - y0;
     let rel = (deflection + B1_TIMOSHENKO_DEFLECTION).abs() / B1_TIMOSHENKO_DEFLECTION;
-    assert!(rel < 0.01, "tip deflection {deflection:e} m, {:.3} % off Timoshenko", 100.0 * rel);
+    assert!(
+        rel < 0.01,
+        "tip deflection {deflection:e} m, {:.3} % off Timoshenko",
+        100.0 * rel
+    );
     // The settled body is in equilibrium: the root reaction balances the tip load (force and
     // moment about the root's reference point, the face centre (0,0,0)). Remaining motion after
     // 1 s at ζ₁ ≈ 0.1 is ~e^{-10.5} of the initial amplitude: 1e-4 relative.
@@ -24,7 +28,12 @@ fn damped_step_response_settles_at_the_static_deflection_and_the_support_balance
     let t = get(&mut s, "root.torque[3]");
     assert!((f - 10.0).abs() < 1e-3 * 10.0, "root.force[2] = {f}");
     assert!((t - 10.0).abs() < 1e-3 * 10.0, "root.torque[3] = {t}");
-    for name in ["root.force[1]", "root.force[3]", "root.torque[1]", "root.torque[2]"] {
+    for name in [
+        "root.force[1]",
+        "root.force[3]",
+        "root.torque[1]",
+        "root.torque[2]",
+    ] {
         let v = get(&mut s, name);
         assert!(v.abs() < 1e-3, "{name} = {v}");
     }

@@ -64,14 +64,20 @@ impl FrameWeights {
     /// `nodes` with positive `weights`, reference positions taken from `reference` (flat `3N`).
     pub fn new(nodes: Vec<usize>, weights: Vec<f64>, reference: &[f64]) -> FrameWeights {
         assert_eq!(nodes.len(), weights.len());
-        assert!(weights.iter().all(|&w| w > 0.0), "frame weights must be positive");
+        assert!(
+            weights.iter().all(|&w| w > 0.0),
+            "frame weights must be positive"
+        );
         let total_weight: f64 = weights.iter().sum();
         let mut centroid = Vector3::zeros();
         for (&n, &w) in nodes.iter().zip(&weights) {
             centroid += w * node(reference, n);
         }
         centroid /= total_weight;
-        let reference_offsets = nodes.iter().map(|&n| node(reference, n) - centroid).collect();
+        let reference_offsets = nodes
+            .iter()
+            .map(|&n| node(reference, n) - centroid)
+            .collect();
         FrameWeights {
             nodes,
             weights,
@@ -95,7 +101,12 @@ impl FrameWeights {
     pub fn best_fit(&self, x: &[f64]) -> Frame {
         let origin = self.centroid(x);
         let mut a = Matrix3::zeros();
-        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+        for ((&n, &w), xbar) in self
+            .nodes
+            .iter()
+            .zip(&self.weights)
+            .zip(&self.reference_offsets)
+        {
             a += w * (node(x, n) - origin) * xbar.transpose();
         }
         Frame {
@@ -109,7 +120,12 @@ impl FrameWeights {
     /// `H δθ = −Σ w_i X̄_i × Rᵀ δx_i` (body-frame `δθ`).
     pub fn rotation_sensitivity(&self, frame: &Frame, x: &[f64]) -> Matrix3<f64> {
         let mut h = Matrix3::zeros();
-        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+        for ((&n, &w), xbar) in self
+            .nodes
+            .iter()
+            .zip(&self.weights)
+            .zip(&self.reference_offsets)
+        {
             let y = frame.rotation.transpose() * (node(x, n) - frame.origin); // X̄_i + ū_i
             h += w * skew(xbar) * skew(&y);
         }
@@ -121,7 +137,12 @@ impl FrameWeights {
     pub fn angular_velocity(&self, frame: &Frame, h_inv: &Matrix3<f64>, v: &[f64]) -> Vector3<f64> {
         let mut b = Vector3::zeros();
         let rt = frame.rotation.transpose();
-        for ((&n, &w), xbar) in self.nodes.iter().zip(&self.weights).zip(&self.reference_offsets) {
+        for ((&n, &w), xbar) in self
+            .nodes
+            .iter()
+            .zip(&self.weights)
+            .zip(&self.reference_offsets)
+        {
             b += w * xbar.cross(&(rt * node(v, n)));
         }
         -(h_inv * b)

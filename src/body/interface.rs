@@ -44,7 +44,9 @@ impl NodeSet {
         reference_point: Option<Vector3<f64>>,
     ) -> Result<NodeSet> {
         if nodes.is_empty() {
-            return Err(Error::new(format!("interface '{name}': its node set is empty")));
+            return Err(Error::new(format!(
+                "interface '{name}': its node set is empty"
+            )));
         }
         let frame_weights = FrameWeights::new(nodes, weights, reference);
         let j = polar_inertia(&frame_weights, reference, &frame_weights.reference_centroid);
@@ -64,12 +66,19 @@ impl NodeSet {
 
     /// Current position of the reference point: `c + R (p_ref − X_c)` with the best-fit frame.
     fn reference_point_at(&self, frame: &Frame) -> Vector3<f64> {
-        frame.origin + frame.rotation * (self.reference_point - self.frame_weights.reference_centroid)
+        frame.origin
+            + frame.rotation * (self.reference_point - self.frame_weights.reference_centroid)
     }
 
     /// Adds the nodal loads of force `force` and torque `torque` about the reference point
     /// (N, N·m, global frame) at positions `x` to `f` (flat `3N`).
-    pub fn distribute(&self, x: &[f64], force: &Vector3<f64>, torque: &Vector3<f64>, f: &mut [f64]) {
+    pub fn distribute(
+        &self,
+        x: &[f64],
+        force: &Vector3<f64>,
+        torque: &Vector3<f64>,
+        f: &mut [f64],
+    ) {
         let fw = &self.frame_weights;
         let frame = fw.best_fit(x);
         let p = self.reference_point_at(&frame);
@@ -159,8 +168,14 @@ mod tests {
             }
         }
         let weights = (0..9).map(|i| 1.0 + (i % 4) as f64).collect();
-        let set = NodeSet::new("tip", (0..9).collect(), weights, &x, Some(Vector3::new(1.0, 0.0, 0.0)))
-            .unwrap();
+        let set = NodeSet::new(
+            "tip",
+            (0..9).collect(),
+            weights,
+            &x,
+            Some(Vector3::new(1.0, 0.0, 0.0)),
+        )
+        .unwrap();
         (x, set)
     }
 
@@ -183,7 +198,11 @@ mod tests {
         // an arbitrary (non-rigid) velocity field
         let mut v = vec![0.0; x.len()];
         for i in 0..n {
-            set_node(&mut v, i, &Vector3::new((i as f64).sin(), (2.0 * i as f64).cos(), 0.3 * i as f64));
+            set_node(
+                &mut v,
+                i,
+                &Vector3::new((i as f64).sin(), (2.0 * i as f64).cos(), 0.3 * i as f64),
+            );
         }
         let force = Vector3::new(1.0, -10.0, 3.0);
         let torque = Vector3::new(0.5, 0.2, -0.1);

@@ -119,8 +119,8 @@ impl Body {
         }
     }
 
-    /// `y = M v = (Ms ⊗ I3) v` for a flat `3N` vector (no allocation: `Ms` acts on each
-    /// direction through a strided copy in `scratch`, length `3N`).
+    /// `y = M v = (Ms ⊗ I3) v` for a flat `3N` vector (no allocation: `Ms` acts on the three
+    /// directions of each node at once).
     pub fn mass_times(&self, v: &[f64], y: &mut [f64]) {
         let ms = &self.mass_matrix;
         for i in 0..ms.n {
@@ -186,17 +186,15 @@ impl Body {
             let fd = &mut scratch.damping_force;
             if beta != 0.0 {
                 self.stiffness_matrix.mul_vec(rate, fd);
-                for k in 0..fd.len() {
-                    fd[k] *= beta;
-                }
+                fd.iter_mut().for_each(|v| *v *= beta);
             } else {
                 fd.fill(0.0);
             }
             if alpha != 0.0 {
                 let mt = &mut scratch.mass_times;
                 self.mass_times(rate, mt);
-                for k in 0..fd.len() {
-                    fd[k] += alpha * mt[k];
+                for (v, m) in fd.iter_mut().zip(mt.iter()) {
+                    *v += alpha * m;
                 }
             }
         }
@@ -242,7 +240,8 @@ impl Body {
         let mut scratch = self.force_scratch();
         let mut f = vec![0.0; x.len()];
         let zero = vec![0.0; x.len()];
-        self.internal_force(x, &zero, &mut scratch, &mut f).strain_energy
+        self.internal_force(x, &zero, &mut scratch, &mut f)
+            .strain_energy
     }
 }
 

@@ -316,8 +316,9 @@ impl<S: CoSimSlave> Instance<S> {
     /// reach the importer).
     fn flush_events(&mut self) {
         let logger = &mut self.logger;
-        self.slave
-            .drain_events(&mut |category, message| logger.log(fmi2Status::fmi2OK, category, message));
+        self.slave.drain_events(&mut |category, message| {
+            logger.log(fmi2Status::fmi2OK, category, message)
+        });
     }
 
     /// The calling-sequence state.

@@ -143,8 +143,8 @@ pub struct ModelSpec {
 impl BodyFile {
     /// Parses and checks a body file; the error says what is wrong and where.
     pub fn from_json(text: &str) -> Result<BodyFile> {
-        let body: BodyFile = serde_json::from_str(text)
-            .map_err(|e| Error::new(format!("body file: {e}")))?;
+        let body: BodyFile =
+            serde_json::from_str(text).map_err(|e| Error::new(format!("body file: {e}")))?;
         body.check()?;
         Ok(body)
     }
@@ -164,15 +164,23 @@ impl BodyFile {
         let mut seen = std::collections::BTreeSet::new();
         for i in &self.interfaces {
             let ok = !i.name.is_empty()
-                && i.name.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
-                && i.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+                && i.name
+                    .chars()
+                    .next()
+                    .is_some_and(|c| c.is_ascii_alphabetic())
+                && i.name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_');
             if !ok {
                 return Err(Error::new(format!(
                     "body file: interface name '{}' must start with a letter and contain only letters, digits and '_'",
                     i.name
                 )));
             }
-            if matches!(i.name.as_str(), "body" | "material" | "damping" | "gravity" | "initial" | "solver" | "model") {
+            if matches!(
+                i.name.as_str(),
+                "body" | "material" | "damping" | "gravity" | "initial" | "solver" | "model"
+            ) {
                 return Err(Error::new(format!(
                     "body file: interface name '{}' is reserved for the FMU's own variables",
                     i.name

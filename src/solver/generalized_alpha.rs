@@ -75,7 +75,10 @@ impl FreeNodes {
     /// Free nodes of `body` when `clamped` nodes are held.
     pub fn new(body: &Body, clamped: &[bool]) -> FreeNodes {
         let nodes: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
-        let dofs: Vec<usize> = nodes.iter().flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+        let dofs: Vec<usize> = nodes
+            .iter()
+            .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
         let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
         let stiffness = body.stiffness_matrix.submatrix(&dofs);
         let scalar_mass = body.mass_matrix.submatrix(&nodes);
@@ -145,7 +148,8 @@ impl DynamicState {
         self.position.copy_from_slice(&other.position);
         self.velocity.copy_from_slice(&other.velocity);
         self.acceleration.copy_from_slice(&other.acceleration);
-        self.pseudo_acceleration.copy_from_slice(&other.pseudo_acceleration);
+        self.pseudo_acceleration
+            .copy_from_slice(&other.pseudo_acceleration);
     }
 }
 
@@ -358,6 +362,8 @@ pub fn initial_acceleration(
             state.acceleration[3 * i + d] = rhs[k];
         }
     }
-    state.pseudo_acceleration.copy_from_slice(&state.acceleration);
+    state
+        .pseudo_acceleration
+        .copy_from_slice(&state.acceleration);
     Ok(())
 }
