@@ -3,7 +3,7 @@
 //! arguments and the calling sequence.
 
 use crate::body::frame::{nearest_rotation, node, set_node};
-use crate::body::interface::InterfaceMotion;
+use crate::body::interface::{DrivingFrame, InterfaceMotion};
 use crate::body::{Body, BodyOptions, NodeSet};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::{self, IsotropicMaterial};
@@ -18,6 +18,10 @@ use crate::solver::generalized_alpha::{
 };
 use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
+
+/// The input values of one interface, indexed by value-reference slot
+/// ([`InterfaceQuantity::slot`]).
+type Inputs = [f64; 30];
 
 /// Most factorizations kept (one per internal step size in use).
 const MATRIX_CACHE_SIZE: usize = 4;
@@ -125,8 +129,8 @@ struct Model {
 #[derive(Debug, Clone, PartialEq)]
 struct Dynamics {
     state: DynamicState,
-    /// Force and torque inputs per interface that `state`'s accelerations belong to.
-    loads: Vec<[f64; 6]>,
+    /// Inputs per interface that `state`'s accelerations belong to.
+    loads: Vec<Inputs>,
     gravity: [f64; 3],
 }
 
@@ -135,7 +139,7 @@ struct Dynamics {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SlaveState {
     parameters: Parameters,
-    inputs: Vec<[f64; 6]>,
+    inputs: Vec<Inputs>,
     start_time: f64,
     dynamics: Option<Dynamics>,
 }
@@ -171,7 +175,10 @@ pub struct Slave {
     size: f64,
     defaults: Parameters,
     parameters: Parameters,
-    inputs: Vec<[f64; 6]>,
+    inputs: Vec<Inputs>,
+    default_inputs: Vec<Inputs>,
+    /// The driving frames of motion interfaces during the current step.
+    driving: Vec<DrivingFrame>,
     start_time: f64,
     model: Option<Model>,
     dynamics: Option<Dynamics>,
@@ -222,7 +229,7 @@ impl Slave {
                 .select(&mesh)
                 .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
             let weights = nodes.iter().map(|&i| lumped[i]).collect();
-            if spec.kind == InterfaceKind::Fixed {
+            if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
                 for &i in &nodes {
                     clamped[i] = true;
                 }
@@ -259,6 +266,21 @@ impl Slave {
         }
         let guid = guid_of(&body_file);
         let n_interfaces = interfaces.len();
+        // Motion interfaces start at their place in the body file, at rest.
+        let default_inputs: Vec<Inputs> = interfaces
+            .iter()
+            .map(|i| {
+                let mut values = [0.0; 30];
+                if i.kind == InterfaceKind::Motion {
+                    let p = InterfaceQuantity::Position.slot() as usize;
+                    values[p..p + 3].copy_from_slice(i.set.reference_point.as_slice());
+                    let r = InterfaceQuantity::Rotation.slot() as usize;
+                    values[r..r + 9]
+                        .copy_from_slice(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+                }
+                values
+            })
+            .collect();
         Ok(Slave {
             body_file,
             variables,
@@ -269,7 +291,9 @@ impl Slave {
             size,
             parameters: defaults.clone(),
             defaults,
-            inputs: vec![[0.0; 6]; n_interfaces],
+            inputs: default_inputs.clone(),
+            default_inputs,
+            driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
             dynamics: None,
@@ -383,7 +407,7 @@ impl Slave {
     /// assembled matrices are kept for reuse if the parameters come back the same.
     pub fn reset(&mut self) {
         self.parameters = self.defaults.clone();
-        self.inputs.iter_mut().for_each(|i| *i = [0.0; 6]);
+        self.inputs.clone_from(&self.default_inputs);
         self.start_time = 0.0;
         self.dynamics = None;
         self.backup = None;
@@ -447,7 +471,15 @@ impl Slave {
             (VariableType::Real, Target::Fixed { key, component }) => {
                 format_real(read_parameter(&self.defaults, key, component).unwrap_or(0.0))
             }
-            _ => "0.0".to_string(),
+            (
+                VariableType::Real,
+                Target::Interface {
+                    index,
+                    quantity,
+                    component,
+                },
+            ) => format_real(self.default_inputs[index][quantity.slot() as usize + component]),
+            _ => "0".to_string(),
         }
     }
 
@@ -525,11 +557,7 @@ impl Slave {
                 if !value.is_finite() {
                     return Err(Error::invalid_value(&v.name, value, "not a finite number"));
                 }
-                if !matches!(
-                    quantity,
-                    InterfaceQuantity::Force | InterfaceQuantity::Torque
-                ) || self.interfaces[index].kind != InterfaceKind::Force
-                {
+                if v.causality != crate::model::Causality::Input {
                     return Err(Error::new(format!(
                         "{} is an output and cannot be set",
                         v.name
@@ -632,6 +660,7 @@ impl Slave {
             ));
         }
         let h = big_h / substeps;
+        self.update_driving_frames()?;
         let index = self.matrix_index(h)?;
         let settings = IterationSettings {
             absolute_tolerance: self.parameters.tolerance * self.size,
@@ -648,6 +677,11 @@ impl Slave {
         let body = &model.body;
         let loads =
             |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        let driving = &self.driving;
+        let t_c = current_communication_point;
+        let prescribe = |t: f64, state: &mut DynamicState| {
+            prescribe_motion(body, interfaces, driving, t - t_c, state)
+        };
         let mut result = Ok(());
         for _ in 0..substeps as usize {
             let r = generalized_alpha::step(
@@ -657,6 +691,7 @@ impl Slave {
                 &mut model.matrices[index],
                 &settings,
                 &loads,
+                &prescribe,
                 h,
                 &mut dynamics.state,
                 &mut model.workspace,
@@ -700,6 +735,18 @@ impl Slave {
                 })
             }
         }
+    }
+
+    /// The driving frames of the motion interfaces from the current inputs (no allocation unless
+    /// an input is rejected).
+    fn update_driving_frames(&mut self) -> Result<()> {
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            if interface.kind == InterfaceKind::Motion {
+                self.driving[k] =
+                    driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
+            }
+        }
+        Ok(())
     }
 
     /// Builds the model if the parameters it depends on changed (assembly and frames).
@@ -785,30 +832,63 @@ impl Slave {
         Ok(model.matrices.len() - 1)
     }
 
-    /// Places the body rigidly at the initial pose with the initial velocity and computes the
-    /// consistent initial acceleration, unless that was done for the current parameters.
+    /// Places the body rigidly and computes the consistent initial acceleration (DESIGN.md
+    /// section 4): with motion interfaces, so that the first one's constraint holds at t0 with its
+    /// input velocities (the others must agree with that rigid placement); without, at
+    /// `initial.position`/`initial.rotation` with `initial.velocity`/`initial.angularVelocity`.
     fn ensure_initial_state(&mut self) -> Result<()> {
         self.ensure_model()?;
+        self.update_driving_frames()?;
         let p = &self.parameters;
-        let q = Matrix3::from_row_slice(&p.initial_rotation);
-        let deviation = (q.transpose() * q - Matrix3::identity()).amax();
-        if deviation > 1e-6 || q.determinant() <= 0.0 {
+        // The placement x_i = origin + Q (X_i − anchor), ẋ_i = v + ω × Q (X_i − anchor).
+        let first_motion = self
+            .interfaces
+            .iter()
+            .position(|i| i.kind == InterfaceKind::Motion);
+        let (origin, q, anchor, v0, w0, source) = match first_motion {
+            Some(k) => {
+                let f = &self.driving[k];
+                let name = &self.body_file.interfaces[k].name;
+                (
+                    f.position,
+                    f.rotation,
+                    self.interfaces[k].set.reference_point,
+                    f.velocity,
+                    f.angular_velocity,
+                    format!("the inputs of motion interface '{name}'"),
+                )
+            }
+            None => {
+                let q = Matrix3::from_row_slice(&p.initial_rotation);
+                let deviation = (q.transpose() * q - Matrix3::identity()).amax();
+                if deviation > 1e-6 || q.determinant() <= 0.0 {
+                    return Err(Error::new(format!(
+                        "initial.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6})",
+                        p.initial_rotation,
+                        q.determinant()
+                    )));
+                }
+                (
+                    Vector3::from(p.initial_position),
+                    nearest_rotation(&q),
+                    Vector3::zeros(),
+                    Vector3::from(p.initial_velocity),
+                    Vector3::from(p.initial_angular_velocity),
+                    "initial.velocity and initial.angularVelocity".to_string(),
+                )
+            }
+        };
+        let has_fixed = self
+            .interfaces
+            .iter()
+            .any(|i| i.kind == InterfaceKind::Fixed);
+        if has_fixed && (v0.norm() > 0.0 || w0.norm() > 0.0) {
             return Err(Error::new(format!(
-                "initial.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6})",
-                p.initial_rotation,
-                q.determinant()
+                "{source} rejected: velocity {:?}, angular velocity {:?}, but a body held by a fixed support must start at rest",
+                v0.as_slice(),
+                w0.as_slice()
             )));
         }
-        let q = nearest_rotation(&q);
-        let v0 = Vector3::from(p.initial_velocity);
-        let w0 = Vector3::from(p.initial_angular_velocity);
-        if self.clamped.iter().any(|&c| c) && (v0.norm() > 0.0 || w0.norm() > 0.0) {
-            return Err(Error::new(format!(
-                "initial.velocity = {:?} and initial.angularVelocity = {:?} rejected: a body held by a fixed support must start at rest",
-                p.initial_velocity, p.initial_angular_velocity
-            )));
-        }
-        let p0 = Vector3::from(p.initial_position);
         let model = self.model.as_mut().unwrap();
         let body = &model.body;
         let n = body.node_count();
@@ -820,12 +900,46 @@ impl Slave {
             pseudo_acceleration: vec![0.0; 3 * n],
         };
         for i in 0..n {
-            let r = q * node(&body.reference, i);
-            set_node(&mut state.position, i, &(p0 + r));
-            if !self.clamped[i] {
-                set_node(&mut state.velocity, i, &(v0 + w0.cross(&r)));
+            let r = q * (node(&body.reference, i) - anchor);
+            set_node(&mut state.position, i, &(origin + r));
+            set_node(&mut state.velocity, i, &(v0 + w0.cross(&r)));
+        }
+        // Every other motion interface must hold in this rigid placement.
+        let tolerance = 1e-6 * self.size;
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            if interface.kind != InterfaceKind::Motion || Some(k) == first_motion {
+                continue;
+            }
+            let mut placed = state.clone();
+            interface.set.prescribe(
+                &body.reference,
+                &self.driving[k],
+                0.0,
+                &mut placed.position,
+                &mut placed.velocity,
+                &mut placed.acceleration,
+            );
+            let gap = placed
+                .position
+                .iter()
+                .zip(&state.position)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            if gap > tolerance {
+                return Err(Error::new(format!(
+                    "motion interfaces '{}' and '{}' disagree at t0: no rigid placement of the body satisfies both (their inputs differ by {gap:.3e} m at the nodes; tolerance {tolerance:.1e} m)",
+                    self.body_file.interfaces[first_motion.unwrap()].name,
+                    self.body_file.interfaces[k].name
+                )));
             }
         }
+        for interface in &self.interfaces {
+            if interface.kind == InterfaceKind::Fixed {
+                for &i in &interface.set.frame_weights.nodes {
+                    state.velocity[3 * i..3 * i + 3].fill(0.0);
+                }
+            }
+        }
+        prescribe_motion(body, &self.interfaces, &self.driving, 0.0, &mut state);
         let gravity = Vector3::from(p.gravity);
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
@@ -904,14 +1018,14 @@ impl Slave {
         for (k, interface) in self.interfaces.iter().enumerate() {
             let out = &mut self.outputs.interfaces[k];
             match interface.kind {
-                InterfaceKind::Fixed => {
+                InterfaceKind::Fixed | InterfaceKind::Motion => {
                     // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
                     let (f, t) = interface.set.resultant(&state.position, residual);
                     out[0..3].copy_from_slice(f.as_slice());
                     out[3..6].copy_from_slice(t.as_slice());
                 }
                 InterfaceKind::Force => {
-                    out[0..6].copy_from_slice(&dynamics.loads[k]);
+                    out[0..6].copy_from_slice(&dynamics.loads[k][0..6]);
                     let m: InterfaceMotion =
                         interface
                             .set
@@ -944,12 +1058,57 @@ impl Slave {
     }
 }
 
+/// Clamps the nodes of every motion interface to its driving frame `tau` seconds into the step.
+fn prescribe_motion(
+    body: &Body,
+    interfaces: &[Interface],
+    driving: &[DrivingFrame],
+    tau: f64,
+    state: &mut DynamicState,
+) {
+    for (interface, frame) in interfaces.iter().zip(driving) {
+        if interface.kind == InterfaceKind::Motion {
+            interface.set.prescribe(
+                &body.reference,
+                frame,
+                tau,
+                &mut state.position,
+                &mut state.velocity,
+                &mut state.acceleration,
+            );
+        }
+    }
+}
+
+/// The driving frame of motion interface `name` from its inputs: a rotation input within 1e-3 of
+/// orthonormal is orthonormalised (nearest rotation), one further off is an error.
+fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
+    let slot = |q: InterfaceQuantity| q.slot() as usize;
+    let vector = |q: InterfaceQuantity| Vector3::from_column_slice(&values[slot(q)..slot(q) + 3]);
+    let r = slot(InterfaceQuantity::Rotation);
+    let q = Matrix3::from_row_slice(&values[r..r + 9]);
+    let deviation = (q.transpose() * q - Matrix3::identity()).amax();
+    if deviation > 1e-3 || q.determinant() <= 0.0 {
+        return Err(Error::new(format!(
+            "{name}.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); inputs within 1e-3 of orthonormal are orthonormalised",
+            &values[r..r + 9],
+            q.determinant()
+        )));
+    }
+    Ok(DrivingFrame {
+        position: vector(InterfaceQuantity::Position),
+        rotation: nearest_rotation(&q),
+        velocity: vector(InterfaceQuantity::Velocity),
+        angular_velocity: vector(InterfaceQuantity::AngularVelocity),
+    })
+}
+
 /// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
 /// torque distributed over its node set; added to `f`.
 fn apply_loads(
     body: &Body,
     interfaces: &[Interface],
-    inputs: &[[f64; 6]],
+    inputs: &[Inputs],
     gravity: &Vector3<f64>,
     x: &[f64],
     f: &mut [f64],

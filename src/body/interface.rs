@@ -2,7 +2,7 @@
 //! force and torque over the nodes, the weighted least-squares rigid motion of the nodes that is
 //! power-conjugate to it, and the resultant of nodal loads about the reference point.
 
-use super::frame::{add_node, node, Frame, FrameWeights};
+use super::frame::{add_node, node, set_node, Frame, FrameWeights};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
 
@@ -144,6 +144,62 @@ impl NodeSet {
     }
 }
 
+/// A driving frame given by a motion interface's inputs at the start of a communication step:
+/// origin `p`, rotation `Q`, velocity `v` and angular velocity `ω` (global). Over the step it is
+/// extrapolated with constant velocities: `p(τ) = p + v τ`, `Q(τ) = exp([ω τ]×) Q`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrivingFrame {
+    pub position: Vector3<f64>,
+    pub rotation: Matrix3<f64>,
+    pub velocity: Vector3<f64>,
+    pub angular_velocity: Vector3<f64>,
+}
+
+impl Default for DrivingFrame {
+    fn default() -> Self {
+        DrivingFrame {
+            position: Vector3::zeros(),
+            rotation: Matrix3::identity(),
+            velocity: Vector3::zeros(),
+            angular_velocity: Vector3::zeros(),
+        }
+    }
+}
+
+impl DrivingFrame {
+    /// Origin and rotation `τ` seconds after the inputs were given.
+    pub fn at(&self, tau: f64) -> (Vector3<f64>, Matrix3<f64>) {
+        let turn = nalgebra::Rotation3::from_scaled_axis(self.angular_velocity * tau);
+        (
+            self.position + self.velocity * tau,
+            turn.matrix() * self.rotation,
+        )
+    }
+}
+
+impl NodeSet {
+    /// Clamps the nodes to `frame` at `τ`: `x_i = p(τ) + Q(τ)(X_i − X_ref)`,
+    /// `ẋ_i = v + ω × (x_i − p)`, `ẍ_i = ω × (ω × (x_i − p))` (X_ref: the reference point).
+    pub fn prescribe(
+        &self,
+        reference: &[f64],
+        frame: &DrivingFrame,
+        tau: f64,
+        x: &mut [f64],
+        v: &mut [f64],
+        a: &mut [f64],
+    ) {
+        let (p, q) = frame.at(tau);
+        let w = frame.angular_velocity;
+        for &n in &self.frame_weights.nodes {
+            let r = q * (node(reference, n) - self.reference_point);
+            set_node(x, n, &(p + r));
+            set_node(v, n, &(frame.velocity + w.cross(&r)));
+            set_node(a, n, &w.cross(&w.cross(&r)));
+        }
+    }
+}
+
 /// `J = Σ w_i (|r_i|² I − r_i r_iᵀ)`, `r_i = x_i − c` (kg·m²).
 fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64> {
     let mut j = Matrix3::zeros();
@@ -157,7 +213,6 @@ fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::body::frame::set_node;
 
     fn face() -> (Vec<f64>, NodeSet) {
         // 3×3 grid of nodes in the plane x = 1 with unequal weights

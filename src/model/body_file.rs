@@ -74,6 +74,9 @@ pub enum InterfaceKind {
     Force,
     /// Clamps the node set where the body was placed; outputs the reaction.
     Fixed,
+    /// Clamps the node set to a frame given as input (position, rotation, velocity, angular
+    /// velocity; extrapolated over a step with the input velocities); outputs the constraint load.
+    Motion,
 }
 
 /// A support or interface: a named node set with a reference point.

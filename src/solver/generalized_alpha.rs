@@ -227,7 +227,11 @@ pub fn last_residual(ws: &StepWorkspace) -> &[f64] {
     &ws.internal
 }
 
-/// One step `t → t + h` of `state`. On failure (no convergence, non-finite values) `state` is
+/// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.
+pub type Prescription<'a> = &'a dyn Fn(f64, &mut DynamicState);
+
+/// One step `t → t + h` of `state`. The clamped nodes are set by `prescribe(t + h, state)`; the
+/// free ones follow from the iteration. On failure (no convergence, non-finite values) `state` is
 /// left as it was and the error is an [`crate::ErrorKind::Discard`].
 #[allow(clippy::too_many_arguments)]
 pub fn step(
@@ -237,12 +241,15 @@ pub fn step(
     matrix: &mut IterationMatrix,
     settings: &IterationSettings,
     loads: &dyn Fn(&[f64], &mut [f64]),
+    prescribe: Prescription,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
 ) -> Result<StepReport> {
     ws.previous.copy_from(state);
-    let result = iterate(body, free, scheme, matrix, settings, loads, h, state, ws);
+    let result = iterate(
+        body, free, scheme, matrix, settings, loads, prescribe, h, state, ws,
+    );
     if result.is_err() {
         state.copy_from(&ws.previous);
     }
@@ -257,6 +264,7 @@ fn iterate(
     matrix: &mut IterationMatrix,
     settings: &IterationSettings,
     loads: &dyn Fn(&[f64], &mut [f64]),
+    prescribe: Prescription,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
@@ -286,6 +294,7 @@ fn iterate(
         }
     }
     state.time = prev.time + h;
+    prescribe(state.time, state);
 
     let mut last_correction = f64::INFINITY;
     for iteration in 1..=settings.max_iterations {
@@ -340,7 +349,8 @@ fn iterate(
 }
 
 /// Consistent initial acceleration on the free DOFs: `M_FF ẍ_F = (f_ext − f(x, ẋ) − M_FC ẍ_C)_F`
-/// with `ẍ_C = 0`; one factorization of `Ms_FF` (at initialization only).
+/// with the clamped nodes' accelerations `ẍ_C` as given in `state`; one factorization of `Ms_FF`
+/// (at initialization only).
 pub fn initial_acceleration(
     body: &Body,
     free: &FreeNodes,
@@ -348,7 +358,9 @@ pub fn initial_acceleration(
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
 ) -> Result<()> {
-    state.acceleration.fill(0.0);
+    for &i in &free.nodes {
+        state.acceleration[3 * i..3 * i + 3].fill(0.0);
+    }
     residual(body, state, loads, ws);
     let factor = SparseCholesky::new(&free.scalar_mass)?;
     let mut solve_ws = factor.solve_scratch();
