@@ -228,10 +228,27 @@ impl Slave {
                 .nodes
                 .select(&mesh)
                 .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
-            let weights = nodes.iter().map(|&i| lumped[i]).collect();
+            let weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
             if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
                 for &i in &nodes {
                     clamped[i] = true;
+                }
+            }
+            if let (InterfaceKind::Pin, Some(p)) = (spec.kind, spec.reference_point) {
+                let total: f64 = weights.iter().sum();
+                let centroid = nodes
+                    .iter()
+                    .zip(&weights)
+                    .fold(Vector3::zeros(), |c, (&i, w)| {
+                        c + *w / total * Vector3::from(mesh.nodes()[i])
+                    });
+                if (Vector3::from(p) - centroid).norm() > 1e-9 * (1.0 + centroid.norm()) {
+                    return Err(Error::new(format!(
+                        "interface '{}': a pin holds the weighted centroid {:?} of its node set; referencePoint {:?} must be omitted or equal to it",
+                        spec.name,
+                        centroid.as_slice(),
+                        p
+                    )));
                 }
             }
             let set = NodeSet::new(
@@ -770,7 +787,19 @@ impl Slave {
             },
         );
         let started = std::time::Instant::now();
-        let free = FreeNodes::new(&body, &self.clamped);
+        let mut free = FreeNodes::new(&body, &self.clamped);
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            if interface.kind == InterfaceKind::Pin {
+                let fw = &interface.set.frame_weights;
+                // The target is set where the body is placed (ensure_initial_state).
+                free.add_point_constraint(
+                    &self.body_file.interfaces[k].name,
+                    &fw.nodes,
+                    &fw.weights,
+                    Vector3::zeros(),
+                )?;
+            }
+        }
         let workspace = StepWorkspace::new(&body, &free);
         self.events.push(LogEvent {
             category: "logEvents",
@@ -898,6 +927,7 @@ impl Slave {
             velocity: vec![0.0; 3 * n],
             acceleration: vec![0.0; 3 * n],
             pseudo_acceleration: vec![0.0; 3 * n],
+            multipliers: vec![0.0; model.free.multiplier_count()],
         };
         for i in 0..n {
             let r = q * (node(&body.reference, i) - anchor);
@@ -940,6 +970,26 @@ impl Slave {
             }
         }
         prescribe_motion(body, &self.interfaces, &self.driving, 0.0, &mut state);
+        // Pins hold their node set's centroid where the body was placed; the placement's velocity
+        // must not move it.
+        let pins = self
+            .interfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, i)| i.kind == InterfaceKind::Pin)
+            .map(|(k, _)| k);
+        for (p, k) in pins.enumerate() {
+            let constraint = &mut model.free.constraints[p];
+            constraint.target = constraint.centroid(&state.position);
+            let speed = constraint.centroid(&state.velocity).norm();
+            if speed > 1e-9 * (1.0 + v0.norm() + w0.norm() * self.size) {
+                return Err(Error::new(format!(
+                    "{source} rejected: the initial velocity moves pin '{}' at {speed:.3e} m/s; a pinned body may only turn about its pin",
+                    self.body_file.interfaces[k].name
+                )));
+            }
+        }
+        let body = &model.body;
         let gravity = Vector3::from(p.gravity);
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
@@ -979,7 +1029,8 @@ impl Slave {
         let loads_in = &dynamics.loads;
         let loads =
             |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, loads_in, &gravity, x, f);
-        let kin = generalized_alpha::residual(body, state, &loads, &mut model.workspace);
+        let kin =
+            generalized_alpha::residual(body, &model.free, state, &loads, &mut model.workspace);
         let residual = generalized_alpha::last_residual(&model.workspace);
 
         // Body outputs (DESIGN.md section 4).
@@ -1018,6 +1069,18 @@ impl Slave {
         for (k, interface) in self.interfaces.iter().enumerate() {
             let out = &mut self.outputs.interfaces[k];
             match interface.kind {
+                InterfaceKind::Pin => {
+                    // The constraint load on the body is −Cᵀλ: resultant −λ_p, no torque about
+                    // the centroid (the pin's point).
+                    let p = self.interfaces[..k]
+                        .iter()
+                        .filter(|i| i.kind == InterfaceKind::Pin)
+                        .count();
+                    for d in 0..3 {
+                        out[d] = -state.multipliers[3 * p + d];
+                        out[3 + d] = 0.0;
+                    }
+                }
                 InterfaceKind::Fixed | InterfaceKind::Motion => {
                     // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
                     let (f, t) = interface.set.resultant(&state.position, residual);

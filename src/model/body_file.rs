@@ -74,6 +74,10 @@ pub enum InterfaceKind {
     Force,
     /// Clamps the node set where the body was placed; outputs the reaction.
     Fixed,
+    /// Spherical joint to the ground: the weighted centroid of the node set stays where the body
+    /// was placed (a Lagrange-multiplier constraint); rotation is free. Outputs the reaction
+    /// force (the torque about the centroid is zero).
+    Pin,
     /// Clamps the node set to a frame given as input (position, rotation, velocity, angular
     /// velocity; extrapolated over a step with the input velocities); outputs the constraint load.
     Motion,

@@ -19,6 +19,7 @@
 //! With `ρ∞ = 1` the scheme is the trapezoidal rule (energy-conserving on linear problems).
 
 use super::cholesky::{SolveWorkspace, SparseCholesky};
+use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
 use crate::body::frame::{node, set_node};
 use crate::body::{Body, BodyKinematics, ForceScratch};
 use crate::error::{Error, Result};
@@ -69,6 +70,8 @@ pub struct FreeNodes {
     pub stiffness: SymmetricCsr,
     /// `Ms` restricted to the free nodes (scalar).
     pub scalar_mass: SymmetricCsr,
+    /// Point constraints (pins) on free nodes, solved with Lagrange multipliers.
+    pub constraints: Vec<PointConstraint>,
 }
 
 impl FreeNodes {
@@ -87,7 +90,43 @@ impl FreeNodes {
             mass,
             stiffness,
             scalar_mass,
+            constraints: Vec::new(),
         }
+    }
+
+    /// Adds a point constraint holding the weighted centroid of `nodes` (weights `weights`, any
+    /// positive scale) at `target` (m). Error if a node is clamped.
+    pub fn add_point_constraint(
+        &mut self,
+        name: &str,
+        nodes: &[usize],
+        weights: &[f64],
+        target: nalgebra::Vector3<f64>,
+    ) -> Result<()> {
+        let total: f64 = weights.iter().sum();
+        let mut free_rows = Vec::with_capacity(nodes.len());
+        for &n in nodes {
+            match self.nodes.binary_search(&n) {
+                Ok(k) => free_rows.push(3 * k),
+                Err(_) => {
+                    return Err(Error::new(format!(
+                        "interface '{name}': node {n} is also held by a fixed support or motion interface"
+                    )))
+                }
+            }
+        }
+        self.constraints.push(PointConstraint {
+            nodes: nodes.to_vec(),
+            weights: weights.iter().map(|w| w / total).collect(),
+            free_rows,
+            target,
+        });
+        Ok(())
+    }
+
+    /// Number of Lagrange multipliers (3 per point constraint).
+    pub fn multiplier_count(&self) -> usize {
+        3 * self.constraints.len()
     }
 
     /// Number of free DOFs.
@@ -102,6 +141,8 @@ pub struct IterationMatrix {
     pub step_size: f64,
     pub factor: SparseCholesky,
     workspace: SolveWorkspace,
+    /// `Z = S̄⁻¹ Cᵀ` and the inverse Schur complement when there are point constraints.
+    constraint: Option<ConstraintFactor>,
 }
 
 impl IterationMatrix {
@@ -122,11 +163,21 @@ impl IterationMatrix {
             &free.stiffness,
         );
         let factor = SparseCholesky::new(&s)?;
-        let workspace = factor.solve_scratch();
+        let mut workspace = factor.solve_scratch();
+        let constraint = if free.constraints.is_empty() {
+            None
+        } else {
+            Some(ConstraintFactor::new(
+                &free.constraints,
+                &factor,
+                &mut workspace,
+            )?)
+        };
         Ok(IterationMatrix {
             step_size: h,
             factor,
             workspace,
+            constraint,
         })
     }
 }
@@ -139,6 +190,9 @@ pub struct DynamicState {
     pub velocity: Vec<f64>,
     pub acceleration: Vec<f64>,
     pub pseudo_acceleration: Vec<f64>,
+    /// Lagrange multipliers of the point constraints (N, global; 3 per constraint): the
+    /// constraint load on the body is `−Cᵀλ`.
+    pub multipliers: Vec<f64>,
 }
 
 impl DynamicState {
@@ -150,6 +204,7 @@ impl DynamicState {
         self.acceleration.copy_from_slice(&other.acceleration);
         self.pseudo_acceleration
             .copy_from_slice(&other.pseudo_acceleration);
+        self.multipliers.copy_from_slice(&other.multipliers);
     }
 }
 
@@ -194,15 +249,17 @@ impl StepWorkspace {
                 velocity: vec![0.0; n3],
                 acceleration: vec![0.0; n3],
                 pseudo_acceleration: vec![0.0; n3],
+                multipliers: vec![0.0; free.multiplier_count()],
             },
         }
     }
 }
 
-/// The residual `r = M ẍ + f(x, ẋ) − f_ext(x)` (full `3N`, in `ws.internal`), and the body's
-/// kinematics on the way. `loads(x, f_ext)` adds the external loads to a zeroed `f_ext`.
+/// The residual `r = M ẍ + f(x, ẋ) + Cᵀλ − f_ext(x)` (full `3N`, in `ws.internal`), and the
+/// body's kinematics on the way. `loads(x, f_ext)` adds the external loads to a zeroed `f_ext`.
 pub fn residual(
     body: &Body,
+    free: &FreeNodes,
     state: &DynamicState,
     loads: &dyn Fn(&[f64], &mut [f64]),
     ws: &mut StepWorkspace,
@@ -219,6 +276,7 @@ pub fn residual(
     for k in 0..ws.internal.len() {
         ws.internal[k] += ws.inertia[k] - ws.external[k];
     }
+    add_constraint_forces(&free.constraints, &state.multipliers, &mut ws.internal);
     kin
 }
 
@@ -298,7 +356,7 @@ fn iterate(
 
     let mut last_correction = f64::INFINITY;
     for iteration in 1..=settings.max_iterations {
-        let kin = residual(body, state, loads, ws);
+        let kin = residual(body, free, state, loads, ws);
         let r = kin.frame.rotation;
         let rt = r.transpose();
         // Rotate the free part of the residual into the co-moving frame, solve, rotate back.
@@ -308,6 +366,15 @@ fn iterate(
         matrix
             .factor
             .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
+        if let Some(constraint) = &mut matrix.constraint {
+            constraint.correct(
+                &free.constraints,
+                &state.position,
+                &r,
+                &mut ws.reduced,
+                &mut state.multipliers,
+            );
+        }
         let mut largest: f64 = 0.0;
         for (k, &i) in free.nodes.iter().enumerate() {
             let dx = -(r * node(&ws.reduced, k));
@@ -348,9 +415,11 @@ fn iterate(
     )))
 }
 
-/// Consistent initial acceleration on the free DOFs: `M_FF ẍ_F = (f_ext − f(x, ẋ) − M_FC ẍ_C)_F`
-/// with the clamped nodes' accelerations `ẍ_C` as given in `state`; one factorization of `Ms_FF`
-/// (at initialization only).
+/// Consistent initial acceleration on the free DOFs and multipliers:
+/// `M_FF ẍ_F + Cᵀλ = (f_ext − f(x, ẋ) − M_FC ẍ_C)_F`, `C ẍ = 0`, with the clamped nodes'
+/// accelerations `ẍ_C` as given in `state`. One factorization of `Ms_FF` (at initialization
+/// only); with `s_p` the weights of point constraint `p` on the free nodes, `C M⁻¹ Cᵀ` is
+/// `B ⊗ I3` with the scalar `B_pq = s_pᵀ Ms⁻¹ s_q`.
 pub fn initial_acceleration(
     body: &Body,
     free: &FreeNodes,
@@ -361,10 +430,12 @@ pub fn initial_acceleration(
     for &i in &free.nodes {
         state.acceleration[3 * i..3 * i + 3].fill(0.0);
     }
-    residual(body, state, loads, ws);
+    state.multipliers.fill(0.0);
+    residual(body, free, state, loads, ws);
     let factor = SparseCholesky::new(&free.scalar_mass)?;
     let mut solve_ws = factor.solve_scratch();
-    let mut rhs = vec![0.0; free.nodes.len()];
+    let nf = free.nodes.len();
+    let mut rhs = vec![0.0; nf];
     for d in 0..3 {
         for (k, &i) in free.nodes.iter().enumerate() {
             rhs[k] = -ws.internal[3 * i + d];
@@ -372,6 +443,46 @@ pub fn initial_acceleration(
         factor.solve_in_place(&mut rhs, &mut solve_ws);
         for (k, &i) in free.nodes.iter().enumerate() {
             state.acceleration[3 * i + d] = rhs[k];
+        }
+    }
+    let m = free.constraints.len();
+    if m > 0 {
+        // Ms⁻¹ s_p for every constraint, and B.
+        let mut inv_s = vec![vec![0.0; nf]; m];
+        for (p, c) in free.constraints.iter().enumerate() {
+            for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
+                inv_s[p][row / 3] = w;
+            }
+            factor.solve_in_place(&mut inv_s[p], &mut solve_ws);
+        }
+        let b = nalgebra::DMatrix::from_fn(m, m, |p, q| {
+            free.constraints[p]
+                .free_rows
+                .iter()
+                .zip(&free.constraints[p].weights)
+                .map(|(&row, &w)| w * inv_s[q][row / 3])
+                .sum::<f64>()
+        });
+        let b_inv = b
+            .try_inverse()
+            .ok_or_else(|| Error::new("the pin constraints are redundant"))?;
+        for d in 0..3 {
+            // λ_d = B⁻¹ (C ẍ_u)_d, ẍ_d ← ẍ_d − Σ_p Ms⁻¹ s_p λ_pd.
+            let cx = nalgebra::DVector::from_fn(m, |p, _| {
+                let c = &free.constraints[p];
+                c.nodes
+                    .iter()
+                    .zip(&c.weights)
+                    .map(|(&n, &w)| w * state.acceleration[3 * n + d])
+                    .sum::<f64>()
+            });
+            let lambda = &b_inv * cx;
+            for p in 0..m {
+                state.multipliers[3 * p + d] = lambda[p];
+                for (k, &i) in free.nodes.iter().enumerate() {
+                    state.acceleration[3 * i + d] -= inv_s[p][k] * lambda[p];
+                }
+            }
         }
     }
     state

@@ -1,6 +1,7 @@
 //! Time integration: the constant iteration matrix and its sparse Cholesky factor, generalized-α.
 
 pub mod cholesky;
+pub mod constraints;
 pub mod generalized_alpha;
 
 pub use cholesky::SparseCholesky;
