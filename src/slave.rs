@@ -113,6 +113,12 @@ impl Parameters {
 struct Interface {
     kind: InterfaceKind,
     set: NodeSet,
+    /// Point constraints of a pin (one: the whole set) or a hinge (two: the halves of the set
+    /// on either side of the plane through its centroid normal to the axis): node lists and
+    /// weights.
+    point_constraints: Vec<(Vec<usize>, Vec<f64>)>,
+    /// Index of the first of them in the solver's constraint list.
+    first_constraint: usize,
 }
 
 /// The assembled model for one set of parameters.
@@ -223,6 +229,8 @@ impl Slave {
         let lumped = fem::lumped_masses(&mesh, 1.0);
         let mut interfaces = Vec::new();
         let mut clamped = vec![false; mesh.node_count()];
+        let (lo, hi) = mesh.bounding_box();
+        let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
         for spec in &body_file.interfaces {
             let nodes = spec
                 .nodes
@@ -234,23 +242,7 @@ impl Slave {
                     clamped[i] = true;
                 }
             }
-            if let (InterfaceKind::Pin, Some(p)) = (spec.kind, spec.reference_point) {
-                let total: f64 = weights.iter().sum();
-                let centroid = nodes
-                    .iter()
-                    .zip(&weights)
-                    .fold(Vector3::zeros(), |c, (&i, w)| {
-                        c + *w / total * Vector3::from(mesh.nodes()[i])
-                    });
-                if (Vector3::from(p) - centroid).norm() > 1e-9 * (1.0 + centroid.norm()) {
-                    return Err(Error::new(format!(
-                        "interface '{}': a pin holds the weighted centroid {:?} of its node set; referencePoint {:?} must be omitted or equal to it",
-                        spec.name,
-                        centroid.as_slice(),
-                        p
-                    )));
-                }
-            }
+            let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
             let set = NodeSet::new(
                 &spec.name,
                 nodes,
@@ -261,6 +253,8 @@ impl Slave {
             interfaces.push(Interface {
                 kind: spec.kind,
                 set,
+                point_constraints,
+                first_constraint: 0,
             });
         }
         if clamped.iter().all(|&c| c) {
@@ -268,8 +262,6 @@ impl Slave {
                 "body file: fixed supports hold every node: nothing can move",
             ));
         }
-        let (lo, hi) = mesh.bounding_box();
-        let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
         let variables = VariableTable::new(&body_file.interfaces);
         let defaults = Parameters::from_body_file(&body_file);
         for v in variables.iter() {
@@ -788,14 +780,14 @@ impl Slave {
         );
         let started = std::time::Instant::now();
         let mut free = FreeNodes::new(&body, &self.clamped);
-        for (k, interface) in self.interfaces.iter().enumerate() {
-            if interface.kind == InterfaceKind::Pin {
-                let fw = &interface.set.frame_weights;
+        for (k, interface) in self.interfaces.iter_mut().enumerate() {
+            interface.first_constraint = free.constraints.len();
+            for (nodes, weights) in &interface.point_constraints {
                 // The target is set where the body is placed (ensure_initial_state).
                 free.add_point_constraint(
                     &self.body_file.interfaces[k].name,
-                    &fw.nodes,
-                    &fw.weights,
+                    nodes,
+                    weights,
                     Vector3::zeros(),
                 )?;
             }
@@ -970,23 +962,22 @@ impl Slave {
             }
         }
         prescribe_motion(body, &self.interfaces, &self.driving, 0.0, &mut state);
-        // Pins hold their node set's centroid where the body was placed; the placement's velocity
-        // must not move it.
-        let pins = self
-            .interfaces
-            .iter()
-            .enumerate()
-            .filter(|(_, i)| i.kind == InterfaceKind::Pin)
-            .map(|(k, _)| k);
-        for (p, k) in pins.enumerate() {
-            let constraint = &mut model.free.constraints[p];
-            constraint.target = constraint.centroid(&state.position);
-            let speed = constraint.centroid(&state.velocity).norm();
-            if speed > 1e-9 * (1.0 + v0.norm() + w0.norm() * self.size) {
-                return Err(Error::new(format!(
-                    "{source} rejected: the initial velocity moves pin '{}' at {speed:.3e} m/s; a pinned body may only turn about its pin",
-                    self.body_file.interfaces[k].name
-                )));
+        // Pins and hinges hold their centroids where the body was placed; the placement's
+        // velocity must not move them.
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            let first = interface.first_constraint;
+            for constraint in
+                &mut model.free.constraints[first..first + interface.point_constraints.len()]
+            {
+                constraint.target = constraint.centroid(&state.position);
+                let speed = constraint.centroid(&state.velocity).norm();
+                if speed > 1e-9 * (1.0 + v0.norm() + w0.norm() * self.size) {
+                    return Err(Error::new(format!(
+                        "{source} rejected: the initial velocity moves the {:?} support '{}' at {speed:.3e} m/s; the body may only turn about it",
+                        interface.kind,
+                        self.body_file.interfaces[k].name
+                    )));
+                }
             }
         }
         let body = &model.body;
@@ -1069,17 +1060,27 @@ impl Slave {
         for (k, interface) in self.interfaces.iter().enumerate() {
             let out = &mut self.outputs.interfaces[k];
             match interface.kind {
-                InterfaceKind::Pin => {
-                    // The constraint load on the body is −Cᵀλ: resultant −λ_p, no torque about
-                    // the centroid (the pin's point).
-                    let p = self.interfaces[..k]
+                InterfaceKind::Pin | InterfaceKind::Hinge => {
+                    // The constraint load on the body is −Cᵀλ: per point constraint a force −λ_k
+                    // at its centroid c_k; the torque is taken about the reference point.
+                    let p = interface
+                        .set
+                        .motion(&state.position, &state.velocity, &state.acceleration)
+                        .position;
+                    let (mut force, mut torque) = (Vector3::zeros(), Vector3::zeros());
+                    let first = interface.first_constraint;
+                    for (j, constraint) in model.free.constraints
+                        [first..first + interface.point_constraints.len()]
                         .iter()
-                        .filter(|i| i.kind == InterfaceKind::Pin)
-                        .count();
-                    for d in 0..3 {
-                        out[d] = -state.multipliers[3 * p + d];
-                        out[3 + d] = 0.0;
+                        .enumerate()
+                    {
+                        let m = &state.multipliers[3 * (first + j)..3 * (first + j) + 3];
+                        let f = -Vector3::new(m[0], m[1], m[2]);
+                        force += f;
+                        torque += (constraint.centroid(&state.position) - p).cross(&f);
                     }
+                    out[0..3].copy_from_slice(force.as_slice());
+                    out[3..6].copy_from_slice(torque.as_slice());
                 }
                 InterfaceKind::Fixed | InterfaceKind::Motion => {
                     // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
@@ -1118,6 +1119,89 @@ impl Slave {
         }
         self.outputs.valid = true;
         Ok(())
+    }
+}
+
+/// The point constraints of a pin (the whole set) or a hinge (the two halves of the set on either
+/// side of the plane through its centroid normal to `axis`; both halves' centroids must lie on
+/// the axis, so that turning about it moves neither: a hole or a face with the axis through its
+/// centre). Holding both half-centroids leaves exactly the rotation about the axis free.
+fn point_constraints(
+    spec: &crate::model::InterfaceSpec,
+    nodes: &[usize],
+    weights: &[f64],
+    reference: &[f64],
+    size: f64,
+) -> Result<Vec<(Vec<usize>, Vec<f64>)>> {
+    let total: f64 = weights.iter().sum();
+    let centroid = nodes
+        .iter()
+        .zip(weights)
+        .fold(Vector3::zeros(), |c, (&i, w)| {
+            c + *w / total * node(reference, i)
+        });
+    let tolerance = 1e-9 * size;
+    if matches!(spec.kind, InterfaceKind::Pin | InterfaceKind::Hinge) {
+        if let Some(p) = spec.reference_point {
+            if (Vector3::from(p) - centroid).norm() > tolerance {
+                return Err(Error::new(format!(
+                    "interface '{}': a {:?} acts at the weighted centroid {:?} of its node set; referencePoint {:?} must be omitted or equal to it",
+                    spec.name,
+                    spec.kind,
+                    centroid.as_slice(),
+                    p
+                )));
+            }
+        }
+    }
+    match spec.kind {
+        InterfaceKind::Pin => Ok(vec![(nodes.to_vec(), weights.to_vec())]),
+        InterfaceKind::Hinge => {
+            let axis = spec.axis.map(Vector3::from).unwrap_or_default();
+            if !(axis.norm() > 0.0) {
+                return Err(Error::new(format!(
+                    "interface '{}': a hinge needs a nonzero \"axis\"",
+                    spec.name
+                )));
+            }
+            let axis = axis.normalize();
+            let mut halves = [(Vec::new(), Vec::new()), (Vec::new(), Vec::new())];
+            for (&i, &w) in nodes.iter().zip(weights) {
+                let s = (node(reference, i) - centroid).dot(&axis);
+                if s.abs() > tolerance {
+                    let half = &mut halves[usize::from(s > 0.0)];
+                    half.0.push(i);
+                    half.1.push(w);
+                }
+            }
+            for (nodes, weights) in &halves {
+                let total: f64 = weights.iter().sum();
+                if nodes.is_empty() {
+                    return Err(Error::new(format!(
+                        "interface '{}': the node set does not extend along the hinge axis {:?}",
+                        spec.name,
+                        axis.as_slice()
+                    )));
+                }
+                let c = nodes
+                    .iter()
+                    .zip(weights)
+                    .fold(Vector3::zeros(), |c, (&i, w)| {
+                        c + *w / total * node(reference, i)
+                    });
+                let off_axis = (c - centroid).cross(&axis).norm();
+                if off_axis > 1e-6 * size {
+                    return Err(Error::new(format!(
+                        "interface '{}': the hinge axis {:?} through the centroid {:?} misses the centroid of one half of the node set by {off_axis:.3e} m; choose a set symmetric about the axis (a hole, or a face with the axis through its centre)",
+                        spec.name,
+                        axis.as_slice(),
+                        centroid.as_slice()
+                    )));
+                }
+            }
+            Ok(halves.into_iter().collect())
+        }
+        _ => Ok(Vec::new()),
     }
 }
 

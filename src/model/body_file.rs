@@ -78,6 +78,9 @@ pub enum InterfaceKind {
     /// was placed (a Lagrange-multiplier constraint); rotation is free. Outputs the reaction
     /// force (the torque about the centroid is zero).
     Pin,
+    /// Revolute joint to the ground about `axis` through the node set's centroid: a pin plus
+    /// two more Lagrange-multiplier constraints; only the rotation about the axis is free.
+    Hinge,
     /// Clamps the node set to a frame given as input (position, rotation, velocity, angular
     /// velocity; extrapolated over a step with the input velocities); outputs the constraint load.
     Motion,
@@ -93,6 +96,9 @@ pub struct InterfaceSpec {
     /// Reference point in body coordinates (m); default: the mass-weighted centroid of the nodes.
     #[serde(default)]
     pub reference_point: Option<[f64; 3]>,
+    /// Axis of a `hinge` (body coordinates); it passes through the node set's centroid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
 }
 
 /// Solver defaults (the FMU's `solver.*` parameters start here).

@@ -131,6 +131,8 @@ impl InterfaceQuantity {
             (InterfaceKind::Fixed, Torque) => "Reaction torque of the support on the body about the reference point",
             (InterfaceKind::Pin, Force) => "Reaction force of the pin on the body (global frame)",
             (InterfaceKind::Pin, Torque) => "Reaction torque of the pin about its point (zero: a pin transmits no torque)",
+            (InterfaceKind::Hinge, Force) => "Reaction force of the hinge on the body (global frame)",
+            (InterfaceKind::Hinge, Torque) => "Reaction torque of the hinge about its point (no component along the axis)",
             (InterfaceKind::Motion, Force) => "Constraint force of the driving frame on the body (global frame)",
             (InterfaceKind::Motion, Torque) => "Constraint torque of the driving frame on the body about the reference point",
             (InterfaceKind::Motion, Position) => "Position of the driving frame: the reference point follows it",
@@ -279,7 +281,9 @@ pub fn interface_variables(kind: InterfaceKind) -> &'static [(InterfaceQuantity,
             (Acceleration, Output),
             (AngularAcceleration, Output),
         ],
-        InterfaceKind::Fixed | InterfaceKind::Pin => &[(Force, Output), (Torque, Output)],
+        InterfaceKind::Fixed | InterfaceKind::Pin | InterfaceKind::Hinge => {
+            &[(Force, Output), (Torque, Output)]
+        }
         InterfaceKind::Motion => &[
             (Position, Input),
             (Rotation, Input),
