@@ -1158,7 +1158,7 @@ fn point_constraints(
         InterfaceKind::Pin => Ok(vec![(nodes.to_vec(), weights.to_vec())]),
         InterfaceKind::Hinge => {
             let axis = spec.axis.map(Vector3::from).unwrap_or_default();
-            if !(axis.norm() > 0.0) {
+            if axis.norm().is_nan() || axis.norm() <= 0.0 {
                 return Err(Error::new(format!(
                     "interface '{}': a hinge needs a nonzero \"axis\"",
                     spec.name
