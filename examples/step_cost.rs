@@ -1,13 +1,15 @@
-//! Cost of one `fmi2DoStep` of the default body against its floor, one forward and one backward
-//! triangular solve with the factor of the iteration matrix (issue 2's figures).
+//! Cost of one `fmi2DoStep` against its floor, one forward and one backward triangular solve
+//! with the factor of the iteration matrix (the figures of issues 2 and 3).
 //!
-//! `cargo run --release --example step_cost [-- steps]`: prints DOF, nnz of K and of the factor,
-//! the median time of a solve, and for h = 1e-4 and 1e-3 the median time per step, steps per second,
-//! iterations per step and the ratio step/solve. The load is B1's step load (10 N at the tip).
+//! `cargo run --release --example step_cost [-- steps [body.json ...]]` (default: 2000 steps of
+//! the default cantilever, the motion-driven cantilever and a pinned variant). For each body and
+//! h = 1e-4, 1e-3 s it prints DOF, nnz of K and of the factor, the median time of a solve and of a
+//! step, steps per second, iterations per step and the ratio step/solve. The load is B1's: 10 N at
+//! the tip; the pinned variant is the cantilever with its root face on a pin under gravity.
 
 use flexbody::model::{BodyFile, VariableType};
 use flexbody::slave::Slave;
-use flexbody::solver::generalized_alpha::{FreeNodes, GeneralizedAlpha, IterationMatrix};
+use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -21,66 +23,83 @@ fn set(s: &mut Slave, name: &str, value: f64) {
     s.set_real(v.value_reference, value).unwrap();
 }
 
-fn main() {
-    let steps: usize = std::env::args()
-        .nth(1)
-        .and_then(|a| a.parse().ok())
-        .unwrap_or(2000);
-    let body_file = BodyFile::default_body();
-    println!("body: {} ({})", body_file.name, body_file.description);
-
-    for h in [1e-4, 1e-3] {
-        let mut s = Slave::from_body(body_file.clone()).unwrap();
-        s.setup_experiment(0.0, None, None).unwrap();
-        s.enter_initialization_mode().unwrap();
-        set(&mut s, "solver.stepSize", h);
-        set(&mut s, "tip.force[2]", -10.0);
-        let t0 = Instant::now();
-        s.exit_initialization_mode().unwrap();
-        let init = t0.elapsed().as_secs_f64();
-
-        // The floor: one forward + backward solve with the same factor.
-        let body = s.body().unwrap();
-        // nodes at x = 0 are the root support of the default body
-        let clamped: Vec<bool> = (0..body.node_count())
-            .map(|i| body.reference[3 * i].abs() < 1e-12)
+fn bodies(paths: &[String]) -> Vec<BodyFile> {
+    if !paths.is_empty() {
+        return paths
+            .iter()
+            .map(|p| BodyFile::from_json(&std::fs::read_to_string(p).unwrap()).unwrap())
             .collect();
-        let free = FreeNodes::new(body, &clamped);
-        let scheme = GeneralizedAlpha::new(s.parameters().rho_inf);
-        let mut matrix = IterationMatrix::new(&free, &scheme, h, 0.0, 0.0).unwrap();
-        let (dof, nnz_k) = (body.reference.len(), body.stiffness_matrix.nnz());
-        let mut ws = matrix.factor.solve_scratch();
-        let mut rhs = vec![1.0; free.dof_count()];
-        let mut solve = Vec::new();
-        for _ in 0..50 {
-            let t = Instant::now();
-            matrix.factor.solve_in_place(&mut rhs, &mut ws);
-            solve.push(t.elapsed().as_secs_f64());
-            rhs.iter_mut().for_each(|v| *v = 1.0);
-        }
-        let _ = &mut matrix;
-        let solve = median(solve);
+    }
+    let root = env!("CARGO_MANIFEST_DIR");
+    let driven = std::fs::read_to_string(format!("{root}/examples/driven_cantilever.json")).unwrap();
+    let mut pinned = BodyFile::default_body();
+    pinned.name = "pinned_cantilever".into();
+    pinned.interfaces[0].kind = flexbody::model::InterfaceKind::Pin;
+    vec![
+        BodyFile::default_body(),
+        BodyFile::from_json(&driven).unwrap(),
+        pinned,
+    ]
+}
 
-        let mut times = Vec::with_capacity(steps);
-        let mut t = 0.0;
-        for _ in 0..steps {
-            let t1 = Instant::now();
-            s.do_step(t, h).unwrap();
-            times.push(t1.elapsed().as_secs_f64());
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let steps: usize = args.first().and_then(|a| a.parse().ok()).unwrap_or(2000);
+    let paths: Vec<String> = args.iter().skip(1).cloned().collect();
+    println!("| body | h (s) | DOF (free) | nnz(K) | nnz(L) | solve (ms) | step (ms) | steps/s | iterations/step | step/solve |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for body_file in bodies(&paths) {
+        for h in [1e-4, 1e-3] {
+            let mut s = Slave::from_body(body_file.clone()).unwrap();
+            s.setup_experiment(0.0, None, None).unwrap();
+            s.enter_initialization_mode().unwrap();
+            set(&mut s, "solver.stepSize", h);
+            set(&mut s, "tip.force[2]", -10.0);
+            if body_file.name.starts_with("pinned") {
+                set(&mut s, "gravity[1]", 9.81);
+            }
+            s.exit_initialization_mode().unwrap();
+
+            // The floor: one forward + backward solve with a factor of the same matrix.
+            let body = s.body().unwrap();
+            let free = s.free_nodes().unwrap();
+            let scheme = GeneralizedAlpha::new(s.parameters().rho_inf);
+            let matrix = IterationMatrix::new(free, &scheme, h, 0.0, 0.0).unwrap();
+            let mut ws = matrix.factor.solve_scratch();
+            let mut rhs = vec![1.0; free.dof_count()];
+            let mut solve = Vec::new();
+            for _ in 0..200 {
+                rhs.iter_mut().for_each(|v| *v = 1.0);
+                let t = Instant::now();
+                matrix.factor.solve_in_place(&mut rhs, &mut ws);
+                solve.push(t.elapsed().as_secs_f64());
+            }
+            let solve = median(solve);
+            let (dof, free_dof) = (body.reference.len(), free.dof_count());
+            let (nnz_k, nnz_l) = (body.stiffness_matrix.nnz(), matrix.factor.factor_nnz());
+
+            let mut times = Vec::with_capacity(steps);
+            let mut t = 0.0;
+            s.do_step(t, h).unwrap(); // the first step at a step size may factorise
             t += h;
+            let (steps0, iterations0) = s.solver_statistics();
+            for _ in 0..steps {
+                let t1 = Instant::now();
+                s.do_step(t, h).unwrap();
+                times.push(t1.elapsed().as_secs_f64());
+                t += h;
+            }
+            let (steps1, iterations1) = s.solver_statistics();
+            let step = median(times);
+            println!(
+                "| {} | {h:e} | {dof} ({free_dof}) | {nnz_k} | {nnz_l} | {:.3} | {:.3} | {:.0} | {:.2} | {:.2} |",
+                body_file.name,
+                1e3 * solve,
+                1e3 * step,
+                1.0 / step,
+                (iterations1 - iterations0) as f64 / (steps1 - steps0) as f64,
+                step / solve
+            );
         }
-        let step = median(times[1..].to_vec());
-        let (internal_steps, iterations) = s.solver_statistics();
-        println!(
-            "h = {h:e}: DOF {dof} (free {}), nnz(K) {nnz_k}, nnz(L) {}, init {:.3} s, solve {:.3} ms, step {:.3} ms ({:.0} steps/s), {:.2} iterations/step, step/solve {:.2}",
-            free.dof_count(),
-            matrix.factor.factor_nnz(),
-            init,
-            1e3 * solve,
-            1e3 * step,
-            1.0 / step,
-            iterations as f64 / internal_steps as f64,
-            step / solve
-        );
     }
 }

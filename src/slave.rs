@@ -397,6 +397,11 @@ impl Slave {
         self.dynamics.as_ref().map(|d| &d.state)
     }
 
+    /// The free nodes, their reduced matrices and constraints once initialized.
+    pub fn free_nodes(&self) -> Option<&FreeNodes> {
+        self.model.as_ref().map(|m| &m.free)
+    }
+
     /// The assembled body once initialized.
     pub fn body(&self) -> Option<&Body> {
         self.model.as_ref().map(|m| &m.body)
