@@ -1,0 +1,88 @@
+//! B3 (Kane, Ryan & Banerjee 1987): spin-up of a beam on a hub driven through a motion interface.
+//! Without stiffening a linear floating-frame model predicts a tip deflection (in the hub frame)
+//! that grows without bound; the absolute coordinates with the co-rotated strain stay bounded,
+//! lag during the spin-up and return to a small oscillation about zero at constant speed.
+
+mod common;
+use common::*;
+use flexbody::model::BodyFile;
+use flexbody::slave::Slave;
+use nalgebra::{Rotation3, Vector3};
+
+/// Hub angle, rate and acceleration of B3: `θ = Ω/T (t²/2 + (T/2π)² (cos(2πt/T) − 1))` for
+/// t < T = 15 s, then `Ω (t − T/2)`, Ω = 6 rad/s.
+fn hub(t: f64) -> (f64, f64) {
+    let (omega, ts) = (6.0, 15.0);
+    let k = 2.0 * std::f64::consts::PI / ts;
+    if t < ts {
+        (
+            omega / ts * (t * t / 2.0 + ((k * t).cos() - 1.0) / (k * k)),
+            omega / ts * (t - (k * t).sin() / k),
+        )
+    } else {
+        (omega * (t - ts / 2.0), omega)
+    }
+}
+
+#[test]
+fn b3_spin_up_stays_bounded_and_returns_to_the_hub_frame() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/hub_beam.json"
+    ))
+    .unwrap();
+    let mut s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.exit_initialization_mode().unwrap();
+    let h = 1e-2;
+    let mut history = Vec::new();
+    for k in 0..2000 {
+        let t = k as f64 * h;
+        let (theta, rate) = hub(t);
+        let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), theta).matrix();
+        for c in 0..9 {
+            set(
+                &mut s,
+                &format!("hub.rotation[{}]", c + 1),
+                q[(c / 3, c % 3)],
+            );
+        }
+        set(&mut s, "hub.angularVelocity[3]", rate);
+        s.do_step(t, h).unwrap();
+        let (theta1, _) = hub(t + h);
+        let q1 = Rotation3::from_axis_angle(&Vector3::z_axis(), theta1);
+        let tip = Vector3::from_fn(|c, _| get(&mut s, &format!("tip.position[{}]", c + 1)));
+        let local = q1.inverse() * tip;
+        history.push((t + h, local.y));
+    }
+    for (t, y) in history.iter().step_by(100) {
+        println!("t = {t:5.2} s: tip deflection in the hub frame {y:+.4} m");
+    }
+    // Measured (hex20 40×1×1, h = 1e-2): peak −0.572 m at t ≈ 7 s, then |y| < 3e-3 m after
+    // 17 s. The assertions are the known qualitative behaviour, not these figures: bounded (a
+    // linear floating frame passes metres here), lagging (negative, peak during the spin-up) and
+    // back to a small oscillation about zero once the rate is constant; the quantitative
+    // comparison with the full nonlinear reference is issue 4's.
+    let (t_peak, y_peak) = history
+        .iter()
+        .copied()
+        .fold((0.0, 0.0), |(tp, yp), (t, y)| {
+            if y.abs() > f64::abs(yp) {
+                (t, y)
+            } else {
+                (tp, yp)
+            }
+        });
+    assert!(
+        y_peak < 0.0 && y_peak > -1.0,
+        "peak tip deflection {y_peak} m"
+    );
+    assert!((4.0..10.0).contains(&t_peak), "peak at t = {t_peak} s");
+    let late = history
+        .iter()
+        .filter(|(t, _)| *t > 17.0)
+        .map(|(_, y)| y.abs())
+        .fold(0.0, f64::max);
+    assert!(late < 0.02 * y_peak.abs(), "late oscillation {late} m");
+}
