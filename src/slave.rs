@@ -696,16 +696,19 @@ impl Slave {
         let prescribe = |t: f64, state: &mut DynamicState| {
             prescribe_motion(body, interfaces, driving, t - t_c, state)
         };
+        let problem = generalized_alpha::StepProblem {
+            body,
+            free: &model.free,
+            scheme: &model.scheme,
+            settings: &settings,
+            loads: &loads,
+            prescribe: &prescribe,
+        };
         let mut result = Ok(());
         for _ in 0..substeps as usize {
             let r = generalized_alpha::step(
-                body,
-                &model.free,
-                &model.scheme,
+                &problem,
                 &mut model.matrices[index],
-                &settings,
-                &loads,
-                &prescribe,
                 h,
                 &mut dynamics.state,
                 &mut model.workspace,

@@ -3,39 +3,32 @@
 
 mod common;
 use common::*;
-use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::Vector3;
 
 const E_SOFT: f64 = 2.1e8;
 
 fn tumbling(nonlinear_forces: bool, h: f64) -> Slave {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/tumbling.json"
-    ))
-    .unwrap();
-    let mut s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
-    s.enter_initialization_mode().unwrap();
-    for (k, w) in [0.5, 3.0, 7.0].iter().enumerate() {
-        set(&mut s, &format!("initial.angularVelocity[{}]", k + 1), *w);
-    }
-    set(
-        &mut s,
-        "model.nonlinearForces",
-        if nonlinear_forces { 1.0 } else { 0.0 },
-    );
-    set(&mut s, "solver.stepSize", h);
-    set(&mut s, "material.youngsModulus", E_SOFT);
     // Spin about the centre of mass (0.5, 0, 0): the centre of mass stays at rest.
-    let w = nalgebra::Vector3::new(0.5, 3.0, 7.0);
-    let v = -w.cross(&nalgebra::Vector3::new(0.5, 0.0, 0.0));
-    for k in 0..3 {
-        set(&mut s, &format!("initial.velocity[{}]", k + 1), v[k]);
-    }
-    s.exit_initialization_mode().unwrap();
-    s
+    let w = Vector3::new(0.5, 3.0, 7.0);
+    let v = -w.cross(&Vector3::new(0.5, 0.0, 0.0));
+    initialized(
+        example_body("tumbling"),
+        &[
+            ("initial.angularVelocity[1]", w.x),
+            ("initial.angularVelocity[2]", w.y),
+            ("initial.angularVelocity[3]", w.z),
+            ("initial.velocity[1]", v.x),
+            ("initial.velocity[2]", v.y),
+            ("initial.velocity[3]", v.z),
+            (
+                "model.nonlinearForces",
+                if nonlinear_forces { 1.0 } else { 0.0 },
+            ),
+            ("solver.stepSize", h),
+            ("material.youngsModulus", E_SOFT),
+        ],
+    )
 }
 
 fn momenta(s: &mut Slave) -> (Vector3<f64>, Vector3<f64>) {

@@ -5,8 +5,6 @@
 
 mod common;
 use common::*;
-use flexbody::model::BodyFile;
-use flexbody::slave::Slave;
 use nalgebra::{Rotation3, Vector3};
 
 /// Hub angle, rate and acceleration of B3: `θ = Ω/T (t²/2 + (T/2π)² (cos(2πt/T) − 1))` for
@@ -26,15 +24,7 @@ fn hub(t: f64) -> (f64, f64) {
 
 #[test]
 fn b3_spin_up_stays_bounded_and_returns_to_the_hub_frame() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/hub_beam.json"
-    ))
-    .unwrap();
-    let mut s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
-    s.enter_initialization_mode().unwrap();
-    s.exit_initialization_mode().unwrap();
+    let mut s = initialized(example_body("hub_beam"), &[]);
     let h = 1e-2;
     let mut history = Vec::new();
     for k in 0..2000 {

@@ -8,19 +8,7 @@ use flexbody::slave::Slave;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
 fn driven(settings: &[(&str, f64)]) -> Slave {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/driven_cantilever.json"
-    ))
-    .unwrap();
-    let mut s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
-    s.enter_initialization_mode().unwrap();
-    for (name, value) in settings {
-        set(&mut s, name, *value);
-    }
-    s.exit_initialization_mode().unwrap();
-    s
+    initialized(example_body("driven_cantilever"), settings)
 }
 
 fn vector(s: &mut Slave, name: &str) -> Vector3<f64> {

@@ -288,45 +288,51 @@ pub fn last_residual(ws: &StepWorkspace) -> &[f64] {
 /// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.
 pub type Prescription<'a> = &'a dyn Fn(f64, &mut DynamicState);
 
+/// What a step needs besides the state: the body, its free nodes and constraints, the scheme, the
+/// iteration settings, the external loads (`loads(x, f_ext)` adds them to a zeroed `f_ext`) and
+/// the prescription of the clamped nodes.
+pub struct StepProblem<'a> {
+    pub body: &'a Body,
+    pub free: &'a FreeNodes,
+    pub scheme: &'a GeneralizedAlpha,
+    pub settings: &'a IterationSettings,
+    pub loads: &'a dyn Fn(&[f64], &mut [f64]),
+    pub prescribe: Prescription<'a>,
+}
+
 /// One step `t → t + h` of `state`. The clamped nodes are set by `prescribe(t + h, state)`; the
 /// free ones follow from the iteration. On failure (no convergence, non-finite values) `state` is
 /// left as it was and the error is an [`crate::ErrorKind::Discard`].
-#[allow(clippy::too_many_arguments)]
 pub fn step(
-    body: &Body,
-    free: &FreeNodes,
-    scheme: &GeneralizedAlpha,
+    problem: &StepProblem,
     matrix: &mut IterationMatrix,
-    settings: &IterationSettings,
-    loads: &dyn Fn(&[f64], &mut [f64]),
-    prescribe: Prescription,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
 ) -> Result<StepReport> {
     ws.previous.copy_from(state);
-    let result = iterate(
-        body, free, scheme, matrix, settings, loads, prescribe, h, state, ws,
-    );
+    let result = iterate(problem, matrix, h, state, ws);
     if result.is_err() {
         state.copy_from(&ws.previous);
     }
     result
 }
 
-#[allow(clippy::too_many_arguments)]
 fn iterate(
-    body: &Body,
-    free: &FreeNodes,
-    scheme: &GeneralizedAlpha,
+    problem: &StepProblem,
     matrix: &mut IterationMatrix,
-    settings: &IterationSettings,
-    loads: &dyn Fn(&[f64], &mut [f64]),
-    prescribe: Prescription,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
 ) -> Result<StepReport> {
+    let StepProblem {
+        body,
+        free,
+        scheme,
+        settings,
+        loads,
+        prescribe,
+    } = *problem;
     let GeneralizedAlpha {
         alpha_m,
         alpha_f,

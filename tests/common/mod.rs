@@ -31,9 +31,15 @@ pub fn get(slave: &mut Slave, name: &str) -> f64 {
     slave.get_real(r).unwrap()
 }
 
-/// The default body (B1), instantiated, with `settings` applied, initialized at t = 0.
-pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
-    let mut slave = Slave::from_body(BodyFile::default_body()).unwrap();
+/// The body file `examples/<name>.json`.
+pub fn example_body(name: &str) -> BodyFile {
+    let path = format!("{}/examples/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    BodyFile::from_json(&std::fs::read_to_string(&path).unwrap()).unwrap()
+}
+
+/// `body` instantiated, with `settings` applied in initialization mode, initialized at t = 0.
+pub fn initialized(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
+    let mut slave = Slave::from_body(body).unwrap();
     slave.setup_experiment(0.0, None, None).unwrap();
     slave.enter_initialization_mode().unwrap();
     for (name, value) in settings {
@@ -41,4 +47,9 @@ pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     }
     slave.exit_initialization_mode().unwrap();
     slave
+}
+
+/// The default body (B1), initialized with `settings`.
+pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
+    initialized(BodyFile::default_body(), settings)
 }
