@@ -8,6 +8,7 @@ pub mod interface;
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
 
+use crate::fem::sparse::BlockCsr3;
 use crate::fem::SymmetricCsr;
 use frame::{add_node, node, set_node};
 use nalgebra::{Matrix3, Vector3};
@@ -43,6 +44,8 @@ pub struct Body {
     pub mass_matrix: SymmetricCsr,
     /// Small-strain stiffness `K` (N/m), `3N × 3N`.
     pub stiffness_matrix: SymmetricCsr,
+    /// The same `K` by 3×3 blocks, for the products of the hot path.
+    stiffness_blocks: BlockCsr3,
     /// Row sums of `Ms` (kg): `M (1 ⊗ a) = (row sums) ⊗ a`, the exact nodal loads of a uniform
     /// acceleration field and the weights of the centre of mass.
     pub mass_row_sums: Vec<f64>,
@@ -94,6 +97,7 @@ impl Body {
         Body {
             reference,
             mass_matrix,
+            stiffness_blocks: BlockCsr3::from_csr(&stiffness_matrix),
             stiffness_matrix,
             mass_row_sums,
             total_mass,
@@ -165,7 +169,7 @@ impl Body {
             set_node(ubar, i, &u);
         }
         let g = &mut scratch.elastic_force;
-        self.stiffness_matrix.mul_vec(ubar, g);
+        self.stiffness_blocks.mul_vec(ubar, g);
         let strain_energy = 0.5 * dot(ubar, g);
 
         let h = fw.rotation_sensitivity(&frame, x);
@@ -185,7 +189,7 @@ impl Body {
             let (alpha, beta) = (self.options.damping_alpha, self.options.damping_beta);
             let fd = &mut scratch.damping_force;
             if beta != 0.0 {
-                self.stiffness_matrix.mul_vec(rate, fd);
+                self.stiffness_blocks.mul_vec(rate, fd);
                 fd.iter_mut().for_each(|v| *v *= beta);
             } else {
                 fd.fill(0.0);
