@@ -31,7 +31,8 @@ fn bodies(paths: &[String]) -> Vec<BodyFile> {
             .collect();
     }
     let root = env!("CARGO_MANIFEST_DIR");
-    let driven = std::fs::read_to_string(format!("{root}/examples/driven_cantilever.json")).unwrap();
+    let driven =
+        std::fs::read_to_string(format!("{root}/examples/driven_cantilever.json")).unwrap();
     let mut pinned = BodyFile::default_body();
     pinned.name = "pinned_cantilever".into();
     pinned.interfaces[0].kind = flexbody::model::InterfaceKind::Pin;
