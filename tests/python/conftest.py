@@ -1,7 +1,10 @@
-"""Fixtures shared by the fmpy tests of the packaged FMU.
+"""Fixtures shared by the fmpy tests of the packaged FMUs.
 
-`cargo xtask test` builds the FMU and passes its path in ``FLEXBODY_FMU``; without it the tests
-look for ``target/fmu/cantilever.fmu`` (what ``cargo xtask fmu`` writes) and fail if it is absent.
+`cargo xtask test` builds the default FMU (``examples/cantilever.json``) and the driven cantilever
+(``examples/driven_cantilever.json``, root clamped to an input frame) and passes their paths in
+``FLEXBODY_FMU`` and ``FLEXBODY_DRIVEN_FMU``; without them the tests look for
+``target/fmu/cantilever.fmu`` and ``target/fmu/driven_cantilever.fmu`` (what
+``cargo xtask fmu [--body examples/driven_cantilever.json]`` writes) and fail if they are absent.
 """
 
 import os
@@ -13,12 +16,16 @@ from fmpy import extract, read_model_description
 REPO = pathlib.Path(__file__).resolve().parents[2]
 
 
+def _packaged_fmu(variable: str, file_name: str, build: str) -> str:
+    path = pathlib.Path(os.environ.get(variable) or REPO / "target" / "fmu" / file_name)
+    if not path.is_file():
+        pytest.fail(f"no FMU at {path}: run `cargo xtask test`, or `{build}` and set {variable}")
+    return str(path)
+
+
 @pytest.fixture(scope="session")
 def fmu_path() -> str:
-    path = pathlib.Path(os.environ.get("FLEXBODY_FMU") or REPO / "target" / "fmu" / "cantilever.fmu")
-    if not path.is_file():
-        pytest.fail(f"no FMU at {path}: run `cargo xtask test`, or `cargo xtask fmu` and set FLEXBODY_FMU")
-    return str(path)
+    return _packaged_fmu("FLEXBODY_FMU", "cantilever.fmu", "cargo xtask fmu")
 
 
 @pytest.fixture(scope="session")
@@ -36,3 +43,21 @@ def unzipdir(fmu_path, tmp_path_factory) -> str:
 def vr(model_description) -> dict:
     """Value reference by variable name."""
     return {v.name: v.valueReference for v in model_description.modelVariables}
+
+
+@pytest.fixture(scope="session")
+def driven_fmu_path() -> str:
+    """The driven cantilever: B1's beam with its root face clamped to the motion interface 'root'."""
+    return _packaged_fmu(
+        "FLEXBODY_DRIVEN_FMU", "driven_cantilever.fmu", "cargo xtask fmu --body examples/driven_cantilever.json"
+    )
+
+
+@pytest.fixture(scope="session")
+def driven_model_description(driven_fmu_path):
+    return read_model_description(driven_fmu_path)
+
+
+@pytest.fixture(scope="session")
+def driven_unzipdir(driven_fmu_path, tmp_path_factory) -> str:
+    return extract(driven_fmu_path, unzipdir=str(tmp_path_factory.mktemp("driven_fmu")))

@@ -4,8 +4,9 @@
 //!   packages `modelDescription.xml`, `binaries/<platform>/<modelIdentifier>.<ext>` and
 //!   `resources/body.json` into an FMI 2.0 `.fmu` (default: `<target>/fmu/<body name>.fmu`).
 //! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), then the
-//!   default FMU, the pinned Python environment (`<target>/venv`) and `pytest tests/python` with
-//!   the FMU's path in `FLEXBODY_FMU`.
+//!   default FMU, the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
+//!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
+//!   `FLEXBODY_FMU` and `FLEXBODY_DRIVEN_FMU`.
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
@@ -27,8 +28,9 @@ usage: cargo xtask <task>
 tasks:
   fmu [--body FILE] [--out FILE]    build the .fmu (default body: examples/cantilever.json,
                                     default out: <target>/fmu/<body name>.fmu)
-  test [--python-only] [ARGS...]    cargo test --workspace, build the default .fmu, set up the
-                                    pinned venv (<target>/venv) and run pytest tests/python
+  test [--python-only] [ARGS...]    cargo test --workspace, build the default and the driven
+                                    cantilever's .fmu, set up the pinned venv (<target>/venv)
+                                    and run pytest tests/python
                                     (ARGS go to pytest; --python-only skips the Rust tests)
   demo                              simulate the default cantilever with fmpy, print a table,
                                     compare with the Timoshenko deflection, plot to
@@ -94,10 +96,13 @@ fn test_task(args: &[String]) -> Result<()> {
         run(workspace.cargo().args(["test", "--workspace"]))?;
     }
     let fmu = workspace.build_fmu(None, None)?;
+    // The second release build is a no-op: only the packaging differs.
+    let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None)?;
     let python = venv::ensure(&workspace)?;
     println!(
-        "xtask test: Python tests (pytest tests/python) on {}",
-        fmu.display()
+        "xtask test: Python tests (pytest tests/python) on {} and {}",
+        fmu.display(),
+        driven_fmu.display()
     );
     let mut pytest = Command::new(&python);
     pytest
@@ -105,6 +110,7 @@ fn test_task(args: &[String]) -> Result<()> {
         .args(["-m", "pytest", "tests/python"])
         .args(pytest_args)
         .env("FLEXBODY_FMU", &fmu)
+        .env("FLEXBODY_DRIVEN_FMU", &driven_fmu)
         .env("MPLBACKEND", "Agg");
     run(&mut pytest)
 }
@@ -175,6 +181,11 @@ impl Workspace {
     /// The default body file (also embedded in the library).
     pub fn default_body(&self) -> PathBuf {
         self.root.join("examples").join("cantilever.json")
+    }
+
+    /// The driven cantilever (root clamped to an input frame): the coupling tests' second body.
+    pub fn driven_body(&self) -> PathBuf {
+        self.root.join("examples").join("driven_cantilever.json")
     }
 
     /// Builds and packages the FMU; returns its path.
