@@ -64,6 +64,8 @@ impl GeneralizedAlpha {
 pub struct FreeNodes {
     /// Free node indices, ascending; free node `k` owns rows `3k..3k+3` of the reduced system.
     pub nodes: Vec<usize>,
+    /// The clamped (prescribed) nodes, ascending.
+    pub clamped: Vec<usize>,
     /// `M ⊗ I3` restricted to the free DOFs.
     pub mass: SymmetricCsr,
     /// `K` restricted to the free DOFs.
@@ -87,6 +89,7 @@ impl FreeNodes {
         let scalar_mass = body.mass_matrix.submatrix(&nodes);
         FreeNodes {
             nodes,
+            clamped: (0..body.node_count()).filter(|&i| clamped[i]).collect(),
             mass,
             stiffness,
             scalar_mass,
@@ -358,7 +361,26 @@ fn iterate(
         }
     }
     state.time = prev.time + h;
+    // Clamped nodes: positions prescribed at t_{n+1}; their velocities and accelerations follow
+    // from the same update formulas as the free nodes', so that the scheme sees one consistent
+    // motion (a jump of the driving velocity at a communication point becomes a finite
+    // acceleration over the step, whose inertia the reaction then carries).
     prescribe(state.time, state);
+    for &i in &free.clamped {
+        for d in 3 * i..3 * i + 3 {
+            let a_old = prev.pseudo_acceleration[d];
+            let a_new = (state.position[d]
+                - prev.position[d]
+                - h * prev.velocity[d]
+                - h * h * (0.5 - beta) * a_old)
+                / (beta * h * h);
+            state.velocity[d] = prev.velocity[d] + h * ((1.0 - gamma) * a_old + gamma * a_new);
+            state.acceleration[d] = ((1.0 - alpha_m) * a_new + alpha_m * a_old
+                - alpha_f * prev.acceleration[d])
+                / (1.0 - alpha_f);
+            state.pseudo_acceleration[d] = a_new;
+        }
+    }
 
     let mut last_correction = f64::INFINITY;
     for iteration in 1..=settings.max_iterations {
