@@ -4,6 +4,7 @@
 
 pub mod assembly;
 pub mod element;
+pub mod geometric;
 pub mod material;
 pub mod modal;
 pub mod quadrature;
