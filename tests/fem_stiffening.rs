@@ -19,8 +19,11 @@
 //!   `(πr/L)² (1 + E/(κG)) ≈ 0.14 %` and `P_E` by `(πr/L)² E/(κG) ≈ 0.1 %`;
 //! * tension acts through the lateral slope only (string term `T w'²`): `K_G` also stiffens the
 //!   axial fibre stretch `σ (∂u_x/∂x)²`, relatively `(πr/L)² ≈ 0.03 %`;
-//! * the 3D solid and the mesh: Hex20 40×2×2 is converged to about 0.1 % (checked below against
-//!   80×2×2 and 40×4×4).
+//! * the 3D solid and the mesh: Hex20 40×2×2 is converged to better than 0.01 % in `ω₁²`
+//!   (checked below against 80×2×2 and 40×4×4).
+//!
+//! Measured (40×2×2): `ω₁²` is 0.13 % below the formula at `T = 0` (the Timoshenko estimate),
+//! 0.04–0.25 % off for `T = −0.5 … 2 P_E`; the buckling load is 0.12 % below `P_E`.
 //!
 //! The tolerance of the issue, 2 %, is thus about ten times the model error; the checks of the
 //! ratio `ω²(T)/ω²(0)` (which cancels the bending errors) are held to 0.5 %.
@@ -51,7 +54,7 @@ fn second_moment() -> f64 {
     SIDE.powi(4) / 12.0
 }
 
-/// Euler buckling load of the pinned–pinned beam, `π² E I / L²` (N): 172.7 N.
+/// Euler buckling load of the pinned–pinned beam, `π² E I / L²` (N): 27.63 kN.
 fn euler_load() -> f64 {
     PI * PI * steel().youngs_modulus * second_moment() / (LENGTH * LENGTH)
 }
@@ -230,7 +233,8 @@ fn preload_stress_is_the_uniform_uniaxial_field() {
 #[test]
 fn mesh_is_converged_for_the_first_bending_frequency() {
     // 40×2×2 against a mesh twice as fine along the axis and one twice as fine across the
-    // section: the lowest ω² with and without tension changes by less than 0.2 %.
+    // section: the lowest ω² with and without tension changes by less than 0.05 % (measured
+    // ≤ 0.006 %), a small fraction of the 2 % budget and of the 0.13 % beam-theory error.
     let base = Beam::new([40, 2, 2]);
     for finer in [[80, 2, 2], [40, 4, 4]] {
         let fine = Beam::new(finer);
@@ -242,7 +246,7 @@ fn mesh_is_converged_for_the_first_bending_frequency() {
                  ({:+.4} %)",
                 100.0 * change
             );
-            assert!(change.abs() < 2e-3, "{finer:?}, T = {tension}: {change:e}");
+            assert!(change.abs() < 5e-4, "{finer:?}, T = {tension}: {change:e}");
         }
     }
 }
@@ -288,7 +292,10 @@ fn lowest_eigenvalue_of_k_plus_kg_crosses_zero_at_the_euler_load() {
     // eigenvalues are μ = λ / (1 + λ) in the same order. Critical compression: λ₁ P_E.
     let k_g = {
         let u = beam.preload_displacement(-p_e);
-        geometric_stiffness(&beam.mesh, &stress_at_gauss_points(&beam.mesh, &steel(), &u))
+        geometric_stiffness(
+            &beam.mesh,
+            &stress_at_gauss_points(&beam.mesh, &steel(), &u),
+        )
     };
     let mut k_plus_g = beam.k.clone();
     weighted_sum_into(&mut k_plus_g, &[(1.0, &beam.k), (-1.0, &k_g)]);

@@ -517,7 +517,11 @@ mod tests {
         // u = A x: ε = sym A at every Gauss point (exact reproduction); σ = D ε with D from
         // `elasticity_matrix` (independent of the λ/μ form used inside). Round-off: 1e-12 of
         // the largest stress component.
-        let a = [[1e-3, -2e-4, 5e-4], [7e-4, -3e-4, -4e-4], [-6e-4, 2.5e-4, 1.5e-4]];
+        let a = [
+            [1e-3, -2e-4, 5e-4],
+            [7e-4, -3e-4, -4e-4],
+            [-6e-4, 2.5e-4, 1.5e-4],
+        ];
         let material = steel();
         let d = material.elasticity_matrix();
         let strain = [
