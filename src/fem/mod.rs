@@ -6,6 +6,7 @@ pub mod assembly;
 pub mod element;
 pub mod material;
 pub mod modal;
+pub mod nonlinear;
 pub mod quadrature;
 pub mod sparse;
 
