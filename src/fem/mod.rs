@@ -7,6 +7,7 @@ pub mod element;
 pub mod geometric;
 pub mod material;
 pub mod modal;
+pub mod nonlinear;
 pub mod quadrature;
 pub mod sparse;
 

@@ -1,0 +1,963 @@
+//! The total-Lagrangian St. Venant–Kirchhoff solid: the `full` reference formulation
+//! (DESIGN.md section 2) on the same meshes, quadrature and DOF numbering (`3 * node + direction`)
+//! as the linear matrices of [`super::assembly`].
+//!
+//! With reference positions `X`, current positions `x = X + u` (m), the displacement gradient
+//! `H = ∂u/∂X`, the deformation gradient `F = I + H` and the Green–Lagrange strain
+//! `E = ½ (FᵀF − I) = ½ (H + Hᵀ + HᵀH)` (computed from `H`, so that small strains keep their
+//! relative precision), the strain energy (J) is
+//!
+//! ```text
+//! W(x) = ∫ ½ λ (tr E)² + μ E:E dV     (reference volume, full Gauss rule: 2×2×2 Hex8, 3×3×3 Hex20)
+//! ```
+//!
+//! the second Piola–Kirchhoff stress (Pa) `S = λ tr(E) I + 2μ E`, the first Piola–Kirchhoff stress
+//! `P = F S`, the internal force (N) `f_a = ∂W/∂x_a = ∫ P ∇N_a dV` and the tangent stiffness (N/m)
+//! `K_T = ∂f/∂x`, whose 3×3 block coupling nodes `a` and `b` is
+//!
+//! ```text
+//! K_ab = ∫ λ g_a g_bᵀ + μ g_b g_aᵀ + μ (∇N_a·∇N_b) F Fᵀ      (material part)
+//!        + (∇N_a · S ∇N_b) I                                  (geometric part)   dV,
+//! ```
+//!
+//! with `∇N_a` the reference gradient of shape function `a` and `g_a = F ∇N_a`. At `x = X`
+//! (`F = I`, `S = 0`) it is the linear small-strain `K` of [`super::stiffness_matrix`]. `K_T` is
+//! symmetric (the Hessian of `W`) but not necessarily positive semi-definite (compressive states).
+//!
+//! Everything mesh-dependent that does not depend on `x` is precomputed by [`SvkSolid::new`]:
+//! reference gradients and weights `det J · w_q` at every Gauss point and the positions of every
+//! element block in the CSR values of `K`; the per-call routines use fixed-size stack arrays and
+//! do not allocate.
+
+use super::element::{full_integration_points, physical_gradients, shape_functions, MAX_NODES};
+use super::quadrature::hexahedron_rule;
+use super::{stiffness_matrix, IsotropicMaterial, SymmetricCsr};
+use crate::mesh::{ElementKind, Mesh};
+
+/// A St. Venant–Kirchhoff solid on a fixed reference mesh: the precomputed data of the strain
+/// energy, internal force and tangent stiffness routines (module documentation for the math).
+#[derive(Debug, Clone)]
+pub struct SvkSolid {
+    kind: ElementKind,
+    /// Nodes per element.
+    nodes_per_element: usize,
+    /// Gauss points per element (8 for Hex8, 27 for Hex20).
+    points_per_element: usize,
+    /// Element node indices, `nodes_per_element` per element, flat.
+    connectivity: Vec<usize>,
+    /// Reference positions `X` (m), flat `3 * node + direction`.
+    reference: Vec<f64>,
+    /// `∇N_a` (1/m) at Gauss point `q` of element `e`: entry `(e · points + q) · nodes + a`.
+    gradients: Vec<[f64; 3]>,
+    /// Integration weights `det J · w_q` (m³) at Gauss point `q` of element `e`: entry `e · points + q`.
+    weights: Vec<f64>,
+    /// Reference positions (m) of the Gauss points, same order as `weights`.
+    gauss_positions: Vec<[f64; 3]>,
+    /// Lamé's `λ` (Pa).
+    lambda: f64,
+    /// Shear modulus `μ` (Pa).
+    mu: f64,
+    /// CSR pattern of `K` (that of [`stiffness_matrix`]).
+    row_ptr: Vec<usize>,
+    col_idx: Vec<usize>,
+    /// For element `e` and local nodes `(a, b)`: the index into the CSR values of entry
+    /// `(3 · node_a, 3 · node_b)`, at `(e · nodes + a) · nodes + b`. Entry `(3 node_a + d,
+    /// 3 node_b + c)` is at that index `+ d · row_length[node_a] + c`.
+    block_offsets: Vec<usize>,
+    /// Length of the CSR rows `3i`, `3i + 1`, `3i + 2` of node `i` (three times its neighbour count).
+    row_length: Vec<usize>,
+}
+
+/// `[xx, yy, zz, yz, xz, xy]` tensor components of a symmetric 3×3 matrix (Voigt order of
+/// [`IsotropicMaterial::elasticity_matrix`], shear components *not* doubled).
+fn voigt(m: &[[f64; 3]; 3]) -> [f64; 6] {
+    [m[0][0], m[1][1], m[2][2], m[1][2], m[0][2], m[0][1]]
+}
+
+/// The Green–Lagrange strain `E = ½ (H + Hᵀ + HᵀH)` of a displacement gradient `H`.
+#[inline(always)]
+fn green_strain(h: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut e = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in i..3 {
+            let hth = h[0][i] * h[0][j] + h[1][i] * h[1][j] + h[2][i] * h[2][j];
+            let v = 0.5 * (h[i][j] + h[j][i] + hth);
+            e[i][j] = v;
+            e[j][i] = v;
+        }
+    }
+    e
+}
+
+impl SvkSolid {
+    /// Precomputes the Gauss-point data of `mesh` (validated: every `det J > 0`) and the
+    /// sparsity pattern of `K` for `material` (only `λ` and `μ` are used; no mass here).
+    pub fn new(mesh: &Mesh, material: &IsotropicMaterial) -> SvkSolid {
+        let kind = mesh.kind();
+        let n = kind.node_count();
+        let rule = hexahedron_rule(full_integration_points(kind));
+        let points = rule.len();
+        let element_count = mesh.element_count();
+        let node_count = mesh.node_count();
+
+        let mut values = Vec::with_capacity(points);
+        let mut derivatives = Vec::with_capacity(points);
+        for q in &rule {
+            let mut v = [0.0; MAX_NODES];
+            let mut d = [[0.0; 3]; MAX_NODES];
+            shape_functions(kind, q.xi, &mut v, &mut d);
+            values.push(v);
+            derivatives.push(d);
+        }
+
+        let mut connectivity = Vec::with_capacity(element_count * n);
+        let mut gradients = Vec::with_capacity(element_count * points * n);
+        let mut weights = Vec::with_capacity(element_count * points);
+        let mut gauss_positions = Vec::with_capacity(element_count * points);
+        let mut coords = [[0.0; 3]; MAX_NODES];
+        let mut g = [[0.0; 3]; MAX_NODES];
+        for e in 0..element_count {
+            let nodes = mesh.element(e);
+            connectivity.extend_from_slice(nodes);
+            for (c, &node) in coords.iter_mut().zip(nodes) {
+                *c = mesh.nodes()[node];
+            }
+            for (q, point) in rule.iter().enumerate() {
+                let det = physical_gradients(&coords[..n], &derivatives[q][..n], &mut g[..n]);
+                assert!(
+                    det > 0.0,
+                    "SvkSolid::new: element {e} has det J = {det} at Gauss point {q}"
+                );
+                gradients.extend_from_slice(&g[..n]);
+                weights.push(det * point.weight);
+                let mut p = [0.0; 3];
+                for (c, v) in coords[..n].iter().zip(&values[q][..n]) {
+                    for d in 0..3 {
+                        p[d] += v * c[d];
+                    }
+                }
+                gauss_positions.push(p);
+            }
+        }
+
+        // The pattern of the linear K (values discarded): identical by construction.
+        let linear = stiffness_matrix(mesh, material);
+        let row_length: Vec<usize> = (0..node_count)
+            .map(|i| linear.row_ptr[3 * i + 1] - linear.row_ptr[3 * i])
+            .collect();
+        let mut block_offsets = Vec::with_capacity(element_count * n * n);
+        for e in 0..element_count {
+            let nodes = mesh.element(e);
+            for &i in nodes {
+                let start = linear.row_ptr[3 * i];
+                let row = &linear.col_idx[start..start + row_length[i]];
+                for &j in nodes {
+                    let p = row
+                        .binary_search(&(3 * j))
+                        .expect("element nodes are neighbours in the pattern of K");
+                    block_offsets.push(start + p);
+                }
+            }
+        }
+
+        SvkSolid {
+            kind,
+            nodes_per_element: n,
+            points_per_element: points,
+            connectivity,
+            reference: mesh.nodes().iter().flatten().copied().collect(),
+            gradients,
+            weights,
+            gauss_positions,
+            lambda: material.lame_lambda(),
+            mu: material.shear_modulus(),
+            row_ptr: linear.row_ptr,
+            col_idx: linear.col_idx,
+            block_offsets,
+            row_length,
+        }
+    }
+
+    /// The element kind of the mesh.
+    pub fn kind(&self) -> ElementKind {
+        self.kind
+    }
+
+    /// Number of DOF, `3 × nodes`.
+    pub fn dof_count(&self) -> usize {
+        self.reference.len()
+    }
+
+    /// Number of elements.
+    pub fn element_count(&self) -> usize {
+        self.connectivity.len() / self.nodes_per_element
+    }
+
+    /// Reference positions `X` (m), flat `3 * node + direction`.
+    pub fn reference_positions(&self) -> &[f64] {
+        &self.reference
+    }
+
+    /// Gauss points per element (8 for Hex8, 27 for Hex20).
+    pub fn gauss_points_per_element(&self) -> usize {
+        self.points_per_element
+    }
+
+    /// Reference positions `X` (m) of all Gauss points, element by element, within an element in
+    /// the order of [`hexahedron_rule`] (ξ fastest). The order of
+    /// [`Self::green_strain_at_gauss_points`].
+    pub fn gauss_point_positions(&self) -> &[[f64; 3]] {
+        &self.gauss_positions
+    }
+
+    /// A matrix with the sparsity pattern of `K` (that of [`stiffness_matrix`]) and zero values:
+    /// the storage [`Self::tangent_stiffness`] writes into. A sparse Cholesky analysed on `K` (or on
+    /// any matrix with this pattern, e.g. `c_m M + K`) can refactor it numerically.
+    pub fn tangent_pattern(&self) -> SymmetricCsr {
+        SymmetricCsr {
+            n: self.dof_count(),
+            row_ptr: self.row_ptr.clone(),
+            col_idx: self.col_idx.clone(),
+            values: vec![0.0; self.col_idx.len()],
+        }
+    }
+
+    /// Copies the displacements `u_a = x_a − X_a` of the nodes of element `e` into `u`.
+    #[inline(always)]
+    fn element_displacements(&self, e: usize, x: &[f64], u: &mut [[f64; 3]; MAX_NODES]) {
+        let n = self.nodes_per_element;
+        for (ua, &node) in u.iter_mut().zip(&self.connectivity[e * n..(e + 1) * n]) {
+            for d in 0..3 {
+                ua[d] = x[3 * node + d] - self.reference[3 * node + d];
+            }
+        }
+    }
+
+    /// Reference gradients `∇N_a` at Gauss point `q` of element `e`, and the weight `det J · w_q`.
+    #[inline(always)]
+    fn point(&self, e: usize, q: usize) -> (&[[f64; 3]], f64) {
+        let n = self.nodes_per_element;
+        let k = e * self.points_per_element + q;
+        (&self.gradients[k * n..(k + 1) * n], self.weights[k])
+    }
+
+    /// `H = Σ_a u_a ⊗ ∇N_a`.
+    #[inline(always)]
+    fn displacement_gradient(u: &[[f64; 3]], g: &[[f64; 3]]) -> [[f64; 3]; 3] {
+        let mut h = [[0.0; 3]; 3];
+        for (ua, ga) in u.iter().zip(g) {
+            for i in 0..3 {
+                for j in 0..3 {
+                    h[i][j] += ua[i] * ga[j];
+                }
+            }
+        }
+        h
+    }
+
+    fn check_positions(&self, x: &[f64], what: &str) {
+        assert_eq!(
+            x.len(),
+            self.dof_count(),
+            "SvkSolid::{what}: x has length {} instead of {}",
+            x.len(),
+            self.dof_count()
+        );
+    }
+
+    /// The strain energy `W(x) = ∫ ½ λ (tr E)² + μ E:E dV` (J) at positions `x` (m, flat).
+    pub fn strain_energy(&self, x: &[f64]) -> f64 {
+        self.check_positions(x, "strain_energy");
+        let mut u = [[0.0; 3]; MAX_NODES];
+        let n = self.nodes_per_element;
+        let mut energy = 0.0;
+        for e in 0..self.element_count() {
+            self.element_displacements(e, x, &mut u);
+            for q in 0..self.points_per_element {
+                let (g, w) = self.point(e, q);
+                let strain = green_strain(&Self::displacement_gradient(&u[..n], g));
+                let trace = strain[0][0] + strain[1][1] + strain[2][2];
+                let ee: f64 = strain.iter().flatten().map(|v| v * v).sum();
+                energy += w * (0.5 * self.lambda * trace * trace + self.mu * ee);
+            }
+        }
+        energy
+    }
+
+    /// The internal force `f = ∂W/∂x`, `f_a = ∫ F S ∇N_a dV` (N), written into `f` (length
+    /// [`Self::dof_count`]; overwritten). No allocation.
+    pub fn internal_force(&self, x: &[f64], f: &mut [f64]) {
+        self.check_positions(x, "internal_force");
+        assert_eq!(
+            f.len(),
+            x.len(),
+            "SvkSolid::internal_force: f has the wrong length"
+        );
+        f.fill(0.0);
+        let n = self.nodes_per_element;
+        let mut u = [[0.0; 3]; MAX_NODES];
+        let mut fe = [[0.0; 3]; MAX_NODES];
+        for e in 0..self.element_count() {
+            self.element_displacements(e, x, &mut u);
+            fe[..n].fill([0.0; 3]);
+            for q in 0..self.points_per_element {
+                let (g, w) = self.point(e, q);
+                let h = Self::displacement_gradient(&u[..n], g);
+                let wp = self.weighted_first_piola(&h, w);
+                for (fa, ga) in fe.iter_mut().zip(g) {
+                    for i in 0..3 {
+                        fa[i] += wp[i][0] * ga[0] + wp[i][1] * ga[1] + wp[i][2] * ga[2];
+                    }
+                }
+            }
+            self.scatter_force(e, &fe, f);
+        }
+    }
+
+    /// `w P = w F S` for the displacement gradient `h` and the weight `w`.
+    #[inline(always)]
+    fn weighted_first_piola(&self, h: &[[f64; 3]; 3], w: f64) -> [[f64; 3]; 3] {
+        let s = self.weighted_second_piola(h, w);
+        let mut p = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                // F = I + H.
+                p[i][j] = s[i][j] + h[i][0] * s[0][j] + h[i][1] * s[1][j] + h[i][2] * s[2][j];
+            }
+        }
+        p
+    }
+
+    /// `w S = w (λ tr(E) I + 2μ E)`.
+    #[inline(always)]
+    fn weighted_second_piola(&self, h: &[[f64; 3]; 3], w: f64) -> [[f64; 3]; 3] {
+        let strain = green_strain(h);
+        let trace = strain[0][0] + strain[1][1] + strain[2][2];
+        let two_mu = 2.0 * self.mu * w;
+        let mut s = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                s[i][j] = two_mu * strain[i][j];
+            }
+            s[i][i] += self.lambda * w * trace;
+        }
+        s
+    }
+
+    #[inline(always)]
+    fn scatter_force(&self, e: usize, fe: &[[f64; 3]; MAX_NODES], f: &mut [f64]) {
+        let n = self.nodes_per_element;
+        for (fa, &node) in fe.iter().zip(&self.connectivity[e * n..(e + 1) * n]) {
+            for d in 0..3 {
+                f[3 * node + d] += fa[d];
+            }
+        }
+    }
+
+    /// The tangent stiffness `K_T = ∂f/∂x` (N/m) at `x`, written into the values of `k`, which
+    /// must have the pattern of [`Self::tangent_pattern`] (its values are overwritten). No
+    /// allocation.
+    pub fn tangent_stiffness(&self, x: &[f64], k: &mut SymmetricCsr) {
+        self.assemble(x, None, k);
+    }
+
+    /// [`Self::internal_force`] and [`Self::tangent_stiffness`] in one pass (what a Newton
+    /// iteration needs). No allocation.
+    pub fn internal_force_and_tangent(&self, x: &[f64], f: &mut [f64], k: &mut SymmetricCsr) {
+        assert_eq!(
+            f.len(),
+            x.len(),
+            "SvkSolid::internal_force_and_tangent: f has the wrong length"
+        );
+        self.assemble(x, Some(f), k);
+    }
+
+    fn assemble(&self, x: &[f64], mut f: Option<&mut [f64]>, k: &mut SymmetricCsr) {
+        self.check_positions(x, "tangent_stiffness");
+        assert!(
+            k.n == self.dof_count()
+                && k.row_ptr.len() == self.row_ptr.len()
+                && k.nnz() == self.col_idx.len(),
+            "SvkSolid::tangent_stiffness: k does not have the pattern of tangent_pattern()"
+        );
+        debug_assert!(k.row_ptr == self.row_ptr && k.col_idx == self.col_idx);
+        k.values.fill(0.0);
+        if let Some(f) = f.as_deref_mut() {
+            f.fill(0.0);
+        }
+        let n = self.nodes_per_element;
+        let (lambda, mu) = (self.lambda, self.mu);
+        let mut u = [[0.0; 3]; MAX_NODES];
+        let mut fe = [[0.0; 3]; MAX_NODES];
+        // Upper-triangle blocks (b ≥ a) of the element tangent, block (a, b) row-major 3×3.
+        let mut ke = [[[0.0f64; 9]; MAX_NODES]; MAX_NODES];
+        // Per Gauss point: g_a = F ∇N_a, λw g_a, μw g_a, w S ∇N_a, μw ∇N_a.
+        let mut cur = [[0.0; 3]; MAX_NODES];
+        let mut lam_cur = [[0.0; 3]; MAX_NODES];
+        let mut mu_cur = [[0.0; 3]; MAX_NODES];
+        let mut s_grad = [[0.0; 3]; MAX_NODES];
+        let mut mu_grad = [[0.0; 3]; MAX_NODES];
+        for e in 0..self.element_count() {
+            self.element_displacements(e, x, &mut u);
+            for (a, row) in ke.iter_mut().enumerate().take(n) {
+                row[a..n].fill([0.0; 9]);
+            }
+            fe[..n].fill([0.0; 3]);
+            for q in 0..self.points_per_element {
+                let (g, w) = self.point(e, q);
+                let h = Self::displacement_gradient(&u[..n], g);
+                let ws = self.weighted_second_piola(&h, w);
+                // F = I + H; B = F Fᵀ.
+                let mut fm = h;
+                for (i, row) in fm.iter_mut().enumerate() {
+                    row[i] += 1.0;
+                }
+                let mut bm = [[0.0; 3]; 3];
+                for i in 0..3 {
+                    for j in i..3 {
+                        let v = fm[i][0] * fm[j][0] + fm[i][1] * fm[j][1] + fm[i][2] * fm[j][2];
+                        bm[i][j] = v;
+                        bm[j][i] = v;
+                    }
+                }
+                for a in 0..n {
+                    let ga = g[a];
+                    let mut c = [0.0; 3];
+                    let mut sg = [0.0; 3];
+                    for i in 0..3 {
+                        c[i] = fm[i][0] * ga[0] + fm[i][1] * ga[1] + fm[i][2] * ga[2];
+                        sg[i] = ws[i][0] * ga[0] + ws[i][1] * ga[1] + ws[i][2] * ga[2];
+                    }
+                    cur[a] = c;
+                    s_grad[a] = sg;
+                    for i in 0..3 {
+                        lam_cur[a][i] = lambda * w * c[i];
+                        mu_cur[a][i] = mu * w * c[i];
+                        mu_grad[a][i] = mu * w * ga[i];
+                    }
+                    // f_a += w P ∇N_a = F (w S ∇N_a).
+                    for i in 0..3 {
+                        fe[a][i] += fm[i][0] * sg[0] + fm[i][1] * sg[1] + fm[i][2] * sg[2];
+                    }
+                }
+                for a in 0..n {
+                    let (la, ma, sa, mga) = (lam_cur[a], mu_cur[a], s_grad[a], mu_grad[a]);
+                    let row = &mut ke[a];
+                    for b in a..n {
+                        let (gb, cb) = (g[b], cur[b]);
+                        let material = mga[0] * gb[0] + mga[1] * gb[1] + mga[2] * gb[2];
+                        let geometric = sa[0] * gb[0] + sa[1] * gb[1] + sa[2] * gb[2];
+                        let block = &mut row[b];
+                        for d in 0..3 {
+                            for c in 0..3 {
+                                block[3 * d + c] +=
+                                    la[d] * cb[c] + ma[c] * cb[d] + material * bm[d][c];
+                            }
+                            block[4 * d] += geometric;
+                        }
+                    }
+                }
+            }
+            let nodes = &self.connectivity[e * n..(e + 1) * n];
+            let offsets = &self.block_offsets[e * n * n..(e + 1) * n * n];
+            for a in 0..n {
+                let stride = self.row_length[nodes[a]];
+                for b in 0..n {
+                    let base = offsets[a * n + b];
+                    for d in 0..3 {
+                        let dst = &mut k.values[base + d * stride..base + d * stride + 3];
+                        for (c, v) in dst.iter_mut().enumerate() {
+                            // K_ba = K_abᵀ; the diagonal blocks are read from their upper
+                            // triangle so that the stored matrix is symmetric to the last bit.
+                            *v += if b > a || (b == a && c >= d) {
+                                ke[a][b][3 * d + c]
+                            } else {
+                                ke[b][a][3 * c + d]
+                            };
+                        }
+                    }
+                }
+            }
+            if let Some(f) = f.as_deref_mut() {
+                self.scatter_force(e, &fe, f);
+            }
+        }
+    }
+
+    /// The Green–Lagrange strain `E = ½ (FᵀF − I)` (dimensionless) at every Gauss point, as
+    /// `[E_xx, E_yy, E_zz, E_yz, E_xz, E_xy]` tensor components (shear not doubled), in the order
+    /// of [`Self::gauss_point_positions`].
+    pub fn green_strain_at_gauss_points(&self, x: &[f64]) -> Vec<[f64; 6]> {
+        let mut out = vec![[0.0; 6]; self.weights.len()];
+        self.green_strain_into(x, &mut out);
+        out
+    }
+
+    /// [`Self::green_strain_at_gauss_points`] into `out` (length: number of Gauss points).
+    pub fn green_strain_into(&self, x: &[f64], out: &mut [[f64; 6]]) {
+        self.check_positions(x, "green_strain_into");
+        assert_eq!(
+            out.len(),
+            self.weights.len(),
+            "SvkSolid::green_strain_into: out has the wrong length"
+        );
+        let n = self.nodes_per_element;
+        let mut u = [[0.0; 3]; MAX_NODES];
+        for e in 0..self.element_count() {
+            self.element_displacements(e, x, &mut u);
+            for q in 0..self.points_per_element {
+                let (g, _) = self.point(e, q);
+                let strain = green_strain(&Self::displacement_gradient(&u[..n], g));
+                out[e * self.points_per_element + q] = voigt(&strain);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
+mod tests {
+    use super::*;
+    use crate::mesh::beam;
+    use crate::solver::cholesky::SparseCholesky;
+    use nalgebra::DMatrix;
+
+    fn kinds() -> [ElementKind; 2] {
+        [ElementKind::Hex8, ElementKind::Hex20]
+    }
+
+    /// A material of unit modulus: energies, forces and stiffnesses are O(1) on O(1) meshes, so
+    /// the finite-difference error estimates below are absolute numbers.
+    fn unit_material() -> IsotropicMaterial {
+        IsotropicMaterial {
+            youngs_modulus: 1.0,
+            poisson_ratio: 0.3,
+            density: 1.0,
+        }
+    }
+
+    fn steel() -> IsotropicMaterial {
+        IsotropicMaterial {
+            youngs_modulus: 2.1e11,
+            poisson_ratio: 0.3,
+            density: 7850.0,
+        }
+    }
+
+    /// A 2×2×1 patch of a 1 × 0.8 × 0.6 box with every node moved by a smooth non-affine field
+    /// (curved Hex20 edges, non-parallelepiped Hex8): the reference gradients differ from element
+    /// to element and point to point.
+    fn distorted_patch(kind: ElementKind) -> Mesh {
+        let mesh = beam(1.0, 0.8, 0.6, [2, 2, 1], kind).unwrap();
+        let nodes: Vec<[f64; 3]> = mesh
+            .nodes()
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 0.06 * (3.0 * p[1]).sin() + 0.04 * p[2] * p[2],
+                    p[1] + 0.05 * (2.0 * p[0]).cos() * p[2],
+                    p[2] + 0.05 * p[0] * p[1] + 0.03 * (4.0 * p[0]).sin(),
+                ]
+            })
+            .collect();
+        let connectivity = (0..mesh.element_count())
+            .flat_map(|e| mesh.element(e).to_vec())
+            .collect();
+        Mesh::new(nodes, kind, connectivity).unwrap()
+    }
+
+    /// Rotation by `angle` (rad) about `axis` (Rodrigues).
+    fn rotation(axis: [f64; 3], angle: f64) -> [[f64; 3]; 3] {
+        let norm = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        let k = [axis[0] / norm, axis[1] / norm, axis[2] / norm];
+        let (s, c) = angle.sin_cos();
+        let mut r = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                r[i][j] = (1.0 - c) * k[i] * k[j] + if i == j { c } else { 0.0 };
+            }
+        }
+        r[0][1] -= s * k[2];
+        r[0][2] += s * k[1];
+        r[1][0] += s * k[2];
+        r[1][2] -= s * k[0];
+        r[2][0] -= s * k[1];
+        r[2][1] += s * k[0];
+        r
+    }
+
+    /// `x = Q (X + u(X)) + c`: a smooth displacement with strains of about 0.1, then a rotation
+    /// by 0.9 rad about a skew axis and a translation.
+    fn rotated_deformed(solid: &SvkSolid) -> Vec<f64> {
+        let q = rotation([0.3, -0.5, 0.8], 0.9);
+        let c = [0.2, -0.1, 0.4];
+        let reference = solid.reference_positions();
+        let mut x = vec![0.0; reference.len()];
+        for (xi, p) in x.chunks_exact_mut(3).zip(reference.chunks_exact(3)) {
+            let y = [
+                p[0] + 0.08 * p[0] * p[0] + 0.05 * p[1] * p[2],
+                p[1] + 0.1 * (2.0 * p[0]).sin() * (1.0 + p[2]),
+                p[2] - 0.06 * p[0] + 0.07 * p[1] * p[1],
+            ];
+            for i in 0..3 {
+                xi[i] = c[i] + q[i][0] * y[0] + q[i][1] * y[1] + q[i][2] * y[2];
+            }
+        }
+        x
+    }
+
+    fn max_abs(v: &[f64]) -> f64 {
+        v.iter().fold(0.0, |m, x| m.max(x.abs()))
+    }
+
+    #[test]
+    fn internal_force_is_the_gradient_of_the_strain_energy() {
+        // Central differences: error ≤ h²/6 |W'''| + ε |W| / h. With E = 1 and strains ~0.1 the
+        // third derivative scales like |f| / ℓ² with ℓ ≈ 0.15–0.25 m the node spacing, so at
+        // h = 1e-5 the truncation is ~1e-11/6 · 40 |f| ≈ 1e-10 |f| and the rounding
+        // ~1e-16 · 1e-2 / 1e-5 = 1e-13. Measured: 1.3e-9 (Hex8) and 2.4e-9 (Hex20) · max|f|.
+        // The bound 1e-8 · max|f| keeps a margin and is far below any wrong term (≥ 1e-3).
+        let h = 1e-5;
+        for kind in kinds() {
+            let solid = SvkSolid::new(&distorted_patch(kind), &unit_material());
+            let x = rotated_deformed(&solid);
+            let mut f = vec![0.0; x.len()];
+            solid.internal_force(&x, &mut f);
+            let scale = max_abs(&f);
+            assert!(
+                scale > 1e-3,
+                "{kind:?}: the deformation must load the patch"
+            );
+            let mut xp = x.clone();
+            let mut worst = 0.0f64;
+            for i in 0..x.len() {
+                xp[i] = x[i] + h;
+                let wp = solid.strain_energy(&xp);
+                xp[i] = x[i] - h;
+                let wm = solid.strain_energy(&xp);
+                xp[i] = x[i];
+                worst = worst.max(((wp - wm) / (2.0 * h) - f[i]).abs());
+            }
+            assert!(
+                worst <= 1e-8 * scale,
+                "{kind:?}: |f − ∇W|∞ = {worst:e}, max|f| = {scale:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn tangent_is_the_jacobian_of_the_internal_force() {
+        // Central differences of f: error ≤ h²/6 |f'''| + ε |f| / h with |f'''| ~ |K| / ℓ² (ℓ the
+        // node spacing, 0.15 m for Hex20): ≈ 1e-11/6 · 44 |K| ≈ 1e-10 |K| plus ~3e-13. Measured:
+        // 2.6e-10 (Hex8) and 1.0e-9 (Hex20) · max|K|; the bound 1e-8 · max|K| keeps a margin and
+        // is orders below a missing term (e.g. the geometric part, ~|S| ~ 1e-1 |K| here).
+        let h = 1e-5;
+        for kind in kinds() {
+            let solid = SvkSolid::new(&distorted_patch(kind), &unit_material());
+            let x = rotated_deformed(&solid);
+            let mut k = solid.tangent_pattern();
+            solid.tangent_stiffness(&x, &mut k);
+            let kd = k.to_dense();
+            let scale = kd.amax();
+            let n = x.len();
+            let (mut fp, mut fm) = (vec![0.0; n], vec![0.0; n]);
+            let mut xp = x.clone();
+            let mut worst = 0.0f64;
+            for j in 0..n {
+                xp[j] = x[j] + h;
+                solid.internal_force(&xp, &mut fp);
+                xp[j] = x[j] - h;
+                solid.internal_force(&xp, &mut fm);
+                xp[j] = x[j];
+                for i in 0..n {
+                    worst = worst.max(((fp[i] - fm[i]) / (2.0 * h) - kd[(i, j)]).abs());
+                }
+            }
+            assert!(
+                worst <= 1e-8 * scale,
+                "{kind:?}: |K_T − ∂f/∂x|∞ = {worst:e}, max|K_T| = {scale:e}"
+            );
+            // The combined pass gives the same force and tangent.
+            let mut f = vec![0.0; n];
+            let mut f2 = vec![0.0; n];
+            let mut k2 = solid.tangent_pattern();
+            solid.internal_force(&x, &mut f);
+            solid.internal_force_and_tangent(&x, &mut f2, &mut k2);
+            let df: f64 = f
+                .iter()
+                .zip(&f2)
+                .fold(0.0, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                df <= 1e-14 * max_abs(&f),
+                "{kind:?}: force differs by {df:e}"
+            );
+            assert_eq!(k2.values, k.values);
+        }
+    }
+
+    #[test]
+    fn tangent_is_symmetric_and_factorizes_on_the_pattern_of_k() {
+        // K_T is the Hessian of W: symmetric. The scatter writes block (b, a) as the transpose of
+        // block (a, b) so the stored matrix must be symmetric to the last bit; a misplaced block
+        // would break that. Then: a Cholesky analysed on the linear K (+ αI) must refactor the
+        // tangent numerically and solve with it.
+        for kind in kinds() {
+            let material = unit_material();
+            let mesh = distorted_patch(kind);
+            let solid = SvkSolid::new(&mesh, &material);
+            let x = rotated_deformed(&solid);
+            let mut k = solid.tangent_pattern();
+            solid.tangent_stiffness(&x, &mut k);
+            let kd = k.to_dense();
+            let asymmetry = (&kd - kd.transpose()).amax();
+            assert_eq!(asymmetry, 0.0, "{kind:?}: K_T is not symmetric");
+
+            let mut shifted = stiffness_matrix(&mesh, &material);
+            let alpha = 0.1 * shifted.diagonal().iter().fold(0.0f64, |m, v| m.max(*v));
+            let add_shift = |m: &mut SymmetricCsr| {
+                for i in 0..m.n {
+                    let (start, end) = (m.row_ptr[i], m.row_ptr[i + 1]);
+                    let p = m.col_idx[start..end].binary_search(&i).unwrap();
+                    m.values[start + p] += alpha;
+                }
+            };
+            add_shift(&mut shifted);
+            let mut cholesky = SparseCholesky::new(&shifted).unwrap();
+            add_shift(&mut k);
+            cholesky.refactor(&k).unwrap();
+            let n = x.len();
+            let rhs: Vec<f64> = (0..n).map(|i| ((i * 7 % 11) as f64 - 5.0) * 0.1).collect();
+            let mut y = rhs.clone();
+            let mut workspace = cholesky.solve_scratch();
+            cholesky.solve_in_place(&mut y, &mut workspace);
+            let mut r = vec![0.0; n];
+            k.mul_vec(&y, &mut r);
+            let err = r
+                .iter()
+                .zip(&rhs)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            // Backward-stable solve: residual ~ ε · cond · |rhs| with a modest condition number.
+            assert!(err <= 1e-10 * max_abs(&rhs), "{kind:?}: residual {err:e}");
+        }
+    }
+
+    #[test]
+    fn rigid_motion_is_stress_free_at_any_angle() {
+        // x = Q X + c exactly gives F = Q, E = 0: only round-off remains. Positions carry an error
+        // ε |x| (|x| ≤ ~3 m here), so H has an error ~ε |x| / ℓ ≈ 1e-15 (node spacing ℓ ≈ 0.2 m),
+        // E ~ 1e-15, and the nodal force is ~(λ + 2μ) E ℓ² ≈ 3e11 · 1e-15 · 0.04 ≈ 1e-5 N
+        // (measured up to 1.5e-4 N). Bounds: strains below 1e-13 (measured ≤ 1e-14), forces below
+        // 1e-13 (λ + 2μ) · 0.1 m² ≈ 3e-3 N, energy below (λ + 2μ) · 1e-28 m³ ≈ 3e-17 J (measured
+        // ≤ 8e-19 J). A unit strain would give forces of ~1e10 N.
+        let material = steel();
+        let modulus = material.lame_lambda() + 2.0 * material.shear_modulus();
+        for kind in kinds() {
+            let solid = SvkSolid::new(&distorted_patch(kind), &material);
+            let reference = solid.reference_positions().to_vec();
+            let mut f = vec![0.0; reference.len()];
+            for (axis, angle) in [
+                ([0.0, 0.0, 1.0], 0.3),
+                ([1.0, 2.0, -0.5], 2.0),
+                ([-0.4, 0.1, 0.9], std::f64::consts::PI),
+                ([0.7, -0.7, 0.2], 4.5),
+                ([0.0, 1.0, 0.0], -17.0),
+            ] {
+                let q = rotation(axis, angle);
+                let c = [1.5, -2.0, 0.7];
+                let mut x = vec![0.0; reference.len()];
+                for (xi, p) in x.chunks_exact_mut(3).zip(reference.chunks_exact(3)) {
+                    for i in 0..3 {
+                        xi[i] = c[i] + q[i][0] * p[0] + q[i][1] * p[1] + q[i][2] * p[2];
+                    }
+                }
+                solid.internal_force(&x, &mut f);
+                let force = max_abs(&f);
+                assert!(
+                    force <= 1e-13 * modulus * 0.1,
+                    "{kind:?} angle {angle}: max|f| = {force:e} N"
+                );
+                let energy = solid.strain_energy(&x);
+                assert!(
+                    energy.abs() <= modulus * 1e-28,
+                    "{kind:?} angle {angle}: W = {energy:e} J"
+                );
+                let strains = solid.green_strain_at_gauss_points(&x);
+                let worst = strains.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(worst <= 1e-13, "{kind:?} angle {angle}: |E| = {worst:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn small_displacement_limit_is_the_linear_stiffness() {
+        // At x = X: F = I, S = 0, and the block formula reduces term by term to the one of
+        // `stiffness_matrix` (same Gauss data): equal to round-off (a few ε · max|K|).
+        // For x = X + u with |∇u| ~ δ, f(X + u) − K u = O(δ²) (the HᵀH of E and F S − S), so
+        // |f − K u| / |K u| ≈ δ: with δ ≈ 1e-7 the bound 1e-5 holds with a wide margin and a
+        // wrong linear term (relative error O(1)) fails it.
+        let material = steel();
+        for kind in kinds() {
+            let mesh = distorted_patch(kind);
+            let solid = SvkSolid::new(&mesh, &material);
+            let linear = stiffness_matrix(&mesh, &material);
+            let reference = solid.reference_positions().to_vec();
+            let mut k = solid.tangent_pattern();
+            solid.tangent_stiffness(&reference, &mut k);
+            assert_eq!((&k.row_ptr, &k.col_idx), (&linear.row_ptr, &linear.col_idx));
+            let scale = max_abs(&linear.values);
+            let worst = k
+                .values
+                .iter()
+                .zip(&linear.values)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                worst <= 1e-14 * scale,
+                "{kind:?}: |K_T(X) − K| = {worst:e}, max|K| = {scale:e}"
+            );
+
+            let delta = 1e-7;
+            let u: Vec<f64> = reference
+                .chunks_exact(3)
+                .flat_map(|p| {
+                    [
+                        delta * (p[1] * p[2] + (3.0 * p[0]).sin()),
+                        delta * (p[0] * p[0] - p[2]),
+                        delta * (2.0 * p[1]).cos() * p[0],
+                    ]
+                })
+                .collect();
+            let x: Vec<f64> = reference.iter().zip(&u).map(|(a, b)| a + b).collect();
+            let n = x.len();
+            let (mut f, mut ku) = (vec![0.0; n], vec![0.0; n]);
+            solid.internal_force(&x, &mut f);
+            linear.mul_vec(&u, &mut ku);
+            let diff = f
+                .iter()
+                .zip(&ku)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                diff <= 1e-5 * max_abs(&ku),
+                "{kind:?}: |f(X+u) − K u| = {diff:e}, |K u| = {:e}",
+                max_abs(&ku)
+            );
+            assert_eq!(solid.strain_energy(&reference), 0.0);
+        }
+    }
+
+    #[test]
+    fn homogeneous_stretch_gives_its_green_strain_and_energy_everywhere() {
+        // x = A X with constant A: both element families reproduce affine fields, so at every
+        // Gauss point E = ½ (AᵀA − I) to round-off, and W = (½ λ (tr E)² + μ E:E) V with V the
+        // reference volume (the weights sum to V; the distorted patch still fills the same volume
+        // as the box only approximately, so V is taken from the weights through the energy of a
+        // stretch with known density).
+        let material = unit_material();
+        let a = [[1.1, 0.05, -0.02], [0.03, 0.95, 0.1], [0.0, -0.04, 1.2]];
+        let mut e = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                let ata: f64 = (0..3).map(|k| a[k][i] * a[k][j]).sum();
+                e[i][j] = 0.5 * (ata - if i == j { 1.0 } else { 0.0 });
+            }
+        }
+        let expected = voigt(&e);
+        let trace = e[0][0] + e[1][1] + e[2][2];
+        let ee: f64 = e.iter().flatten().map(|v| v * v).sum();
+        let density = 0.5 * material.lame_lambda() * trace * trace + material.shear_modulus() * ee;
+        for kind in kinds() {
+            let solid = SvkSolid::new(&distorted_patch(kind), &material);
+            let x: Vec<f64> = solid
+                .reference_positions()
+                .chunks_exact(3)
+                .flat_map(|p| {
+                    let mut y = [0.0; 3];
+                    for i in 0..3 {
+                        y[i] = a[i][0] * p[0] + a[i][1] * p[1] + a[i][2] * p[2];
+                    }
+                    y
+                })
+                .collect();
+            let strains = solid.green_strain_at_gauss_points(&x);
+            assert_eq!(strains.len(), solid.gauss_point_positions().len());
+            assert_eq!(
+                strains.len(),
+                solid.element_count() * solid.gauss_points_per_element()
+            );
+            for s in &strains {
+                for (v, w) in s.iter().zip(&expected) {
+                    assert!((v - w).abs() < 1e-13, "{kind:?}: {s:?} vs {expected:?}");
+                }
+            }
+            let volume: f64 = solid.weights.iter().sum();
+            let energy = solid.strain_energy(&x);
+            assert!(
+                (energy - density * volume).abs() <= 1e-13 * energy,
+                "{kind:?}: W = {energy}, expected {}",
+                density * volume
+            );
+            // A homogeneous stress is self-equilibrated: interior nodes carry no force. Check
+            // the total force and moment instead (they vanish for any state: rigid invariance).
+            let mut f = vec![0.0; x.len()];
+            solid.internal_force(&x, &mut f);
+            let mut total = [0.0; 3];
+            let mut moment = [0.0; 3];
+            for (fi, xi) in f.chunks_exact(3).zip(x.chunks_exact(3)) {
+                for d in 0..3 {
+                    total[d] += fi[d];
+                }
+                moment[0] += xi[1] * fi[2] - xi[2] * fi[1];
+                moment[1] += xi[2] * fi[0] - xi[0] * fi[2];
+                moment[2] += xi[0] * fi[1] - xi[1] * fi[0];
+            }
+            let scale = max_abs(&f);
+            for d in 0..3 {
+                assert!(total[d].abs() <= 1e-13 * scale, "{kind:?}: Σf = {total:?}");
+                assert!(
+                    moment[d].abs() <= 1e-13 * scale,
+                    "{kind:?}: Σx×f = {moment:?}"
+                );
+            }
+        }
+    }
+
+    /// Timing of one internal force and one tangent assembly on B1's mesh (Hex20 20×2×2) and on
+    /// Hex20 40×4×4. Run in release:
+    /// `cargo test --release --lib fem::nonlinear -- --ignored --nocapture`.
+    #[test]
+    #[ignore]
+    fn timing_of_force_and_tangent() {
+        use std::time::Instant;
+        for divisions in [[20, 2, 2], [40, 4, 4]] {
+            let mesh = beam(1.0, 0.02, 0.02, divisions, ElementKind::Hex20).unwrap();
+            let solid = SvkSolid::new(&mesh, &steel());
+            let x: Vec<f64> = solid
+                .reference_positions()
+                .chunks_exact(3)
+                .flat_map(|p| [p[0], p[1] - 0.01 * p[0] * p[0], p[2] + 1e-3 * p[0]])
+                .collect();
+            let n = x.len();
+            let mut f = vec![0.0; n];
+            let mut k = solid.tangent_pattern();
+            let repeats = 20;
+            let time = |run: &mut dyn FnMut()| {
+                run();
+                let start = Instant::now();
+                for _ in 0..repeats {
+                    run();
+                }
+                start.elapsed().as_secs_f64() / repeats as f64 * 1e3
+            };
+            let force_ms = time(&mut || solid.internal_force(&x, &mut f));
+            let energy_ms = time(&mut || {
+                std::hint::black_box(solid.strain_energy(&x));
+            });
+            let tangent_ms = time(&mut || solid.tangent_stiffness(&x, &mut k));
+            let both_ms = time(&mut || solid.internal_force_and_tangent(&x, &mut f, &mut k));
+            println!(
+                "hex20 {divisions:?}: {n} DOF, nnz(K) = {}: internal force {force_ms:.3} ms, \
+                 energy {energy_ms:.3} ms, tangent {tangent_ms:.3} ms, force+tangent {both_ms:.3} ms",
+                k.nnz()
+            );
+        }
+    }
+}
