@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 #[derive(Deserialize)]
 struct Spec {
     units: Vec<Unit>,
+    enumerations: Vec<Enumeration>,
     #[serde(rename = "logCategories")]
     log_categories: Vec<LogCategory>,
     variables: Vec<Var>,
@@ -26,6 +27,14 @@ struct Unit {
     s: i32,
     #[serde(default)]
     rad: i32,
+}
+
+#[derive(Deserialize)]
+struct Enumeration {
+    name: String,
+    description: String,
+    /// (name, description); values 1, 2, ...
+    items: Vec<(String, String)>,
 }
 
 #[derive(Deserialize)]
@@ -47,6 +56,8 @@ struct Var {
     variability: String,
     #[serde(default)]
     unit: Option<String>,
+    #[serde(default, rename = "declaredType")]
+    declared_type: Option<String>,
     #[serde(default)]
     min: Option<f64>,
     #[serde(default)]
@@ -110,9 +121,10 @@ fn main() {
             assert!(names.insert(name.clone()), "duplicate name {name}");
             writeln!(
                 table,
-                "    FixedVariableSpec {{ name: {name:?}, key: FixedKey::{key}, component: {k}, value_reference: {vr}, ty: VariableType::{ty}, causality: Causality::{causality}, variability: Variability::{variability}, unit: {unit}, min: {min}, max: {max}, description: {desc:?} }},",
+                "    FixedVariableSpec {{ name: {name:?}, key: FixedKey::{key}, component: {k}, value_reference: {vr}, ty: VariableType::{ty}, causality: Causality::{causality}, variability: Variability::{variability}, unit: {unit}, declared_type: {declared}, min: {min}, max: {max}, description: {desc:?} }},",
                 key = v.key,
                 unit = match &v.unit { Some(u) => format!("Some({u:?})"), None => "None".into() },
+                declared = match &v.declared_type { Some(u) => format!("Some({u:?})"), None => "None".into() },
                 min = opt_f64(v.min),
                 max = opt_f64(v.max),
                 desc = v.description,
@@ -142,6 +154,17 @@ fn main() {
             out,
             "    UnitSpec {{ name: {:?}, kg: {}, m: {}, s: {}, rad: {} }},",
             u.name, u.kg, u.m, u.s, u.rad
+        )
+        .unwrap();
+    }
+    out.push_str("];\n\n");
+    out.push_str("/// Enumeration types: name, description and items (name, description), valued 1, 2, ...\n");
+    out.push_str("pub const ENUMERATIONS: &[EnumerationSpec] = &[\n");
+    for e in &spec.enumerations {
+        writeln!(
+            out,
+            "    EnumerationSpec {{ name: {:?}, description: {:?}, items: &{:?} }},",
+            e.name, e.description, e.items
         )
         .unwrap();
     }

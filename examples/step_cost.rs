@@ -65,7 +65,7 @@ fn main() {
             let body = s.body().unwrap();
             let free = s.free_nodes().unwrap();
             let scheme = GeneralizedAlpha::new(s.parameters().rho_inf);
-            let matrix = IterationMatrix::new(free, &scheme, h, 0.0, 0.0).unwrap();
+            let matrix = IterationMatrix::new(body, free, &scheme, h, 0.0, 0.0).unwrap();
             let mut ws = matrix.factor.solve_scratch();
             let mut rhs = vec![1.0; free.dof_count()];
             let mut solve = Vec::new();

@@ -4,13 +4,17 @@
 
 use crate::body::frame::{nearest_rotation, node, set_node};
 use crate::body::interface::{DrivingFrame, InterfaceMotion};
+use crate::body::stiffening::Stiffening;
 use crate::body::{Body, BodyOptions, NodeSet};
 use crate::error::{Error, ErrorKind, Result};
+use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::mesh::{self, Mesh};
 use crate::model::body_file::MeshSpec;
 use crate::model::model_description::{format_real, model_description, ModelInfo};
-use crate::model::variables::{FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
+use crate::model::variables::{
+    EnumerationSpec, FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT,
+};
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
 use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
@@ -22,6 +26,12 @@ use std::path::Path;
 /// The input values of one interface, indexed by value-reference slot
 /// ([`InterfaceQuantity::slot`]).
 type Inputs = [f64; 30];
+
+/// `model.formulation` item of the full nonlinear reference.
+const FORMULATION_FULL: i32 = 2;
+/// `model.stiffening` items.
+const STIFFENING_INERTIAL: i32 = 2;
+const STIFFENING_STRESS: i32 = 3;
 
 /// Most factorizations kept (one per internal step size in use).
 const MATRIX_CACHE_SIZE: usize = 4;
@@ -43,6 +53,10 @@ pub struct Parameters {
     pub tolerance: f64,
     pub max_iterations: i32,
     pub nonlinear_forces: bool,
+    /// `model.formulation`: 1 reducedStrain, 2 full.
+    pub formulation: i32,
+    /// `model.stiffening`: 1 none, 2 inertial, 3 stress.
+    pub stiffening: i32,
 }
 
 impl Parameters {
@@ -65,12 +79,14 @@ impl Parameters {
             tolerance: b.solver.tolerance,
             max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
             nonlinear_forces: b.model.nonlinear_forces,
+            formulation: 1,
+            stiffening: 1,
         }
     }
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
     /// placement, the step size and the iteration settings).
-    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool) {
+    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, i32) {
         (
             self.material,
             [
@@ -79,6 +95,7 @@ impl Parameters {
                 self.rho_inf.to_bits(),
             ],
             self.nonlinear_forces,
+            self.formulation * 16 + self.stiffening,
         )
     }
 
@@ -123,12 +140,15 @@ struct Interface {
 
 /// The assembled model for one set of parameters.
 struct Model {
-    key: (IsotropicMaterial, [u64; 3], bool),
+    key: (IsotropicMaterial, [u64; 3], bool, i32),
     body: Body,
     free: FreeNodes,
     scheme: GeneralizedAlpha,
     matrices: Vec<IterationMatrix>,
     workspace: StepWorkspace,
+    /// Geometric stiffening (`model.stiffening` inertial or stress); its `K_G` lives in
+    /// `workspace.geometric_stiffness`.
+    stiffening: Option<Stiffening>,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -594,6 +614,21 @@ impl Slave {
 
     pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
         let v = self.lookup(VariableType::Integer, vr)?;
+        if let Some(e) = v.declared_type.and_then(EnumerationSpec::by_name) {
+            if value < 1 || value as usize > e.items.len() {
+                let names: Vec<String> = e
+                    .items
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (name, _))| format!("{} = {name}", k + 1))
+                    .collect();
+                return Err(Error::invalid_value(
+                    &v.name,
+                    value,
+                    &format!("not an item of {} ({})", e.name, names.join(", ")),
+                ));
+            }
+        }
         match v.target {
             Target::Fixed {
                 key: FixedKey::MaxIterations,
@@ -603,6 +638,20 @@ impl Slave {
                     return Err(Error::invalid_value(&v.name, value, "must be at least 1"));
                 }
                 self.parameters.max_iterations = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Formulation,
+                ..
+            } => {
+                self.parameters.formulation = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Stiffening,
+                ..
+            } => {
+                self.parameters.stiffening = value;
                 Ok(())
             }
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
@@ -682,6 +731,21 @@ impl Slave {
         };
         let model = self.model.as_mut().expect("matrix_index built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
+        if let (Some(stiffening), Some(k_g)) = (
+            model.stiffening.as_mut(),
+            model.workspace.geometric_stiffness.as_mut(),
+        ) {
+            let s = &dynamics.state;
+            stiffening.update(
+                &self.mesh,
+                &self.parameters.material,
+                &model.body,
+                &s.position,
+                &s.velocity,
+                &s.acceleration,
+                k_g,
+            );
+        }
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
         dynamics.state.time = current_communication_point;
@@ -786,6 +850,11 @@ impl Slave {
                 damping_beta: p.damping_beta,
             },
         );
+        let body = if p.formulation == FORMULATION_FULL {
+            body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
+        } else {
+            body
+        };
         let started = std::time::Instant::now();
         let mut free = FreeNodes::new(&body, &self.clamped);
         for (k, interface) in self.interfaces.iter_mut().enumerate() {
@@ -800,7 +869,20 @@ impl Slave {
                 )?;
             }
         }
-        let workspace = StepWorkspace::new(&body, &free);
+        let mut workspace = StepWorkspace::new(&body, &free);
+        let stiffening = match p.stiffening {
+            STIFFENING_INERTIAL => Some(Stiffening::inertial(
+                &self.mesh,
+                &p.material,
+                &body,
+                &self.clamped,
+            )?),
+            STIFFENING_STRESS => Some(Stiffening::stress(&self.mesh, &body)),
+            _ => None,
+        };
+        if stiffening.is_some() {
+            workspace.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
+        }
         self.events.push(LogEvent {
             category: "logEvents",
             message: format!(
@@ -821,6 +903,7 @@ impl Slave {
             scheme: GeneralizedAlpha::new(p.rho_inf),
             matrices: Vec::new(),
             workspace,
+            stiffening,
         });
         self.dynamics = None;
         Ok(())
@@ -840,6 +923,7 @@ impl Slave {
         }
         let started = std::time::Instant::now();
         let matrix = IterationMatrix::new(
+            &model.body,
             &model.free,
             &model.scheme,
             h,
@@ -1063,7 +1147,10 @@ impl Slave {
         out[18..21].copy_from_slice((m * vcom).as_slice());
         out[21..24].copy_from_slice(angular.as_slice());
         out[24] = kinetic;
-        out[25] = kin.strain_energy;
+        out[25] = match &body.full {
+            Some(full) => full.strain_energy(&state.position),
+            None => kin.strain_energy,
+        };
 
         for (k, interface) in self.interfaces.iter().enumerate() {
             let out = &mut self.outputs.interfaces[k];
@@ -1331,6 +1418,8 @@ fn write_parameter(p: &mut Parameters, key: FixedKey, c: usize) -> Option<&mut f
 fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
     match key {
         FixedKey::MaxIterations => Some(p.max_iterations),
+        FixedKey::Formulation => Some(p.formulation),
+        FixedKey::Stiffening => Some(p.stiffening),
         _ => None,
     }
 }

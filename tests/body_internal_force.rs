@@ -53,7 +53,7 @@ fn internal_force_is_the_gradient_of_the_strain_energy() {
     let mut scratch = body.force_scratch();
     let mut f = vec![0.0; x.len()];
     let zero = vec![0.0; x.len()];
-    body.internal_force(&x, &zero, &mut scratch, &mut f);
+    body.internal_force(&x, &zero, None, &mut scratch, &mut f);
     // Central differences: error O(ε²) ≈ 1e-9 relative at ε = 1e-7 m against deformations of
     // 1e-3 m; round-off of V (≈ 1e3 J × 1e-16 / 1e-7) is well below the tolerance.
     let eps = 1e-7;
@@ -77,7 +77,7 @@ fn internal_force_is_the_gradient_of_the_strain_energy() {
     // Without f_nl the force misses a term of second order in ū: the mismatch is visible.
     let linear = small_beam(BodyOptions::default());
     let mut fl = vec![0.0; x.len()];
-    linear.internal_force(&x, &zero, &mut scratch, &mut fl);
+    linear.internal_force(&x, &zero, None, &mut scratch, &mut fl);
     let diff = f
         .iter()
         .zip(&fl)
@@ -100,7 +100,7 @@ fn with_f_nl_the_internal_force_has_no_net_force_or_moment() {
         let mut scratch = body.force_scratch();
         let mut f = vec![0.0; xs.len()];
         let zero = vec![0.0; xs.len()];
-        body.internal_force(&xs, &zero, &mut scratch, &mut f);
+        body.internal_force(&xs, &zero, None, &mut scratch, &mut f);
         let (mut force, mut moment, mut scale) = (Vector3::zeros(), Vector3::zeros(), 0.0_f64);
         for i in 0..body.node_count() {
             force += node(&f, i);
@@ -138,8 +138,8 @@ fn damping_leaves_rigid_motion_of_a_deformed_body_undamped() {
     }
     let mut scratch = body.force_scratch();
     let (mut fd, mut f0) = (vec![0.0; x.len()], vec![0.0; x.len()]);
-    body.internal_force(&x, &v, &mut scratch, &mut fd);
-    undamped.internal_force(&x, &v, &mut scratch, &mut f0);
+    body.internal_force(&x, &v, None, &mut scratch, &mut fd);
+    undamped.internal_force(&x, &v, None, &mut scratch, &mut f0);
     let scale = f0.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
     let diff = fd
         .iter()
@@ -160,8 +160,8 @@ fn damping_leaves_rigid_motion_of_a_deformed_body_undamped() {
             &(node(&v, i) + Vector3::new(0.0, 0.05 * p.x * p.x, 0.0)),
         );
     }
-    body.internal_force(&x, &vd, &mut scratch, &mut fd);
-    undamped.internal_force(&x, &vd, &mut scratch, &mut f0);
+    body.internal_force(&x, &vd, None, &mut scratch, &mut fd);
+    undamped.internal_force(&x, &vd, None, &mut scratch, &mut f0);
     let power: f64 = (0..x.len()).map(|k| (fd[k] - f0[k]) * vd[k]).sum();
     assert!(
         power > 0.0,

@@ -4,10 +4,12 @@
 
 pub mod frame;
 pub mod interface;
+pub mod stiffening;
 
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
 
+use crate::fem::nonlinear::SvkSolid;
 use crate::fem::sparse::BlockCsr3;
 use crate::fem::SymmetricCsr;
 use frame::{add_node, node, set_node};
@@ -54,6 +56,10 @@ pub struct Body {
     /// The co-moving frame over all nodes with HRZ-lumped masses as weights.
     pub frame_weights: FrameWeights,
     pub options: BodyOptions,
+    /// The full nonlinear reference formulation (`model.formulation = full`): when present, the
+    /// elastic force is the total-Lagrangian St. Venant–Kirchhoff force of `x` instead of
+    /// `R K ū` (+ `f_nl`); damping stays the co-rotated one.
+    pub full: Option<SvkSolid>,
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -63,7 +69,8 @@ pub struct BodyKinematics {
     pub frame: Frame,
     /// Angular velocity of the co-moving frame in body axes `ω̄` (rad/s).
     pub angular_velocity_body: Vector3<f64>,
-    /// `V = ½ ūᵀ K ū` (J).
+    /// `V = ½ ūᵀ K ū` (J); not computed (NaN) for the full formulation, see
+    /// [`Body::strain_energy`].
     pub strain_energy: f64,
 }
 
@@ -75,6 +82,19 @@ pub struct ForceScratch {
     deformation_rate: Vec<f64>,
     damping_force: Vec<f64>,
     mass_times: Vec<f64>,
+    stiffening_force: Vec<f64>,
+}
+
+impl ForceScratch {
+    /// The local deformation `ū` of the last [`Body::internal_force`] call (flat 3N, m).
+    pub fn local_deformation(&self) -> &[f64] {
+        &self.local_deformation
+    }
+
+    /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N).
+    pub fn elastic_force(&self) -> &[f64] {
+        &self.elastic_force
+    }
 }
 
 impl Body {
@@ -103,7 +123,14 @@ impl Body {
             total_mass,
             frame_weights,
             options,
+            full: None,
         }
+    }
+
+    /// The same body with the full nonlinear formulation of `material` (its `λ`, `μ`).
+    pub fn with_full_formulation(mut self, full: SvkSolid) -> Body {
+        self.full = Some(full);
+        self
     }
 
     /// Number of nodes `N`.
@@ -120,6 +147,7 @@ impl Body {
             deformation_rate: vec![0.0; n3],
             damping_force: vec![0.0; n3],
             mass_times: vec![0.0; n3],
+            stiffening_force: vec![0.0; n3],
         }
     }
 
@@ -151,10 +179,14 @@ impl Body {
     ///   `V = ½ ūᵀ K ū`;
     /// * damping `f_d = hR (α Ms⊗I3 + β K) dū/dt`, `dū_i/dt = Rᵀ(ẋ_i − ċ) − ω̄ × (X̄_i + ū_i)`,
     ///   zero for any rigid motion.
+    ///
+    /// `geometric_stiffness`, when given, adds the stiffening force `f_stiff = hR K_G ū`
+    /// (DESIGN.md section 2) with `K_G` of the current prestress.
     pub fn internal_force(
         &self,
         x: &[f64],
         v: &[f64],
+        geometric_stiffness: Option<&SymmetricCsr>,
         scratch: &mut ForceScratch,
         f: &mut [f64],
     ) -> BodyKinematics {
@@ -169,8 +201,16 @@ impl Body {
             set_node(ubar, i, &u);
         }
         let g = &mut scratch.elastic_force;
-        self.stiffness_blocks.mul_vec(ubar, g);
-        let strain_energy = 0.5 * dot(ubar, g);
+        let strain_energy = if let Some(full) = &self.full {
+            full.internal_force(x, g); // global frame
+            f64::NAN
+        } else {
+            self.stiffness_blocks.mul_vec(ubar, g);
+            0.5 * dot(ubar, g)
+        };
+        if let Some(kg) = geometric_stiffness {
+            kg.mul_vec(ubar, &mut scratch.stiffening_force);
+        }
 
         let h = fw.rotation_sensitivity(&frame, x);
         let h_inv = h.try_inverse().unwrap_or_else(Matrix3::zeros);
@@ -204,7 +244,7 @@ impl Body {
         }
 
         // f_nl: z = H⁻ᵀ m̄, m̄ = Σ ū_i × g_i (elastic g only: f_nl is part of ∂V/∂x).
-        let z = if self.options.nonlinear_forces {
+        let z = if self.options.nonlinear_forces && self.full.is_none() {
             let mut mbar = Vector3::zeros();
             for i in 0..n {
                 mbar += node(ubar, i).cross(&node(g, i));
@@ -215,14 +255,25 @@ impl Body {
         };
 
         for i in 0..n {
-            let mut fi = node(g, i);
+            // Terms in the co-moving frame, rotated to global at the end.
+            let mut fi = Vector3::zeros();
+            if self.full.is_none() {
+                fi += node(g, i);
+            }
             if damped {
                 fi += node(&scratch.damping_force, i);
             }
-            if self.options.nonlinear_forces {
+            if geometric_stiffness.is_some() {
+                fi += node(&scratch.stiffening_force, i);
+            }
+            if self.options.nonlinear_forces && self.full.is_none() {
                 fi -= fw.weights[i] * fw.reference_offsets[i].cross(&z);
             }
-            set_node(f, i, &(r * fi));
+            let mut global = r * fi;
+            if self.full.is_some() {
+                global += node(g, i);
+            }
+            set_node(f, i, &global);
         }
         BodyKinematics {
             frame,
@@ -239,12 +290,21 @@ impl Body {
         }
     }
 
-    /// Strain energy `V = ½ ūᵀ K ū` of positions `x` (J); allocates (not for the hot path).
+    /// `y = K x` (3×3-block product, no allocation).
+    pub fn stiffness_product(&self, x: &[f64], y: &mut [f64]) {
+        self.stiffness_blocks.mul_vec(x, y);
+    }
+
+    /// Strain energy of positions `x` (J): `V = ½ ūᵀ K ū`, or the St. Venant–Kirchhoff energy
+    /// of the full formulation; allocates (not for the hot path).
     pub fn strain_energy(&self, x: &[f64]) -> f64 {
+        if let Some(full) = &self.full {
+            return full.strain_energy(x);
+        }
         let mut scratch = self.force_scratch();
         let mut f = vec![0.0; x.len()];
         let zero = vec![0.0; x.len()];
-        self.internal_force(x, &zero, &mut scratch, &mut f)
+        self.internal_force(x, &zero, None, &mut scratch, &mut f)
             .strain_energy
     }
 }

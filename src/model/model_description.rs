@@ -10,7 +10,8 @@
 //! under `<InitialUnknowns>` (no dependencies attribute: depends on all inputs).
 
 use super::variables::{
-    Causality, Variability, Variable, VariableTable, VariableType, LOG_CATEGORIES, UNITS,
+    Causality, Variability, Variable, VariableTable, VariableType, ENUMERATIONS, LOG_CATEGORIES,
+    UNITS,
 };
 use super::MODEL_IDENTIFIER;
 use std::fmt::Write as _;
@@ -152,6 +153,31 @@ pub fn model_description(
         x.push_str("  </UnitDefinitions>\n");
     }
 
+    // Enumeration types used by the variables, in the order of ENUMERATIONS.
+    let declared: Vec<&str> = table.iter().filter_map(|v| v.declared_type).collect();
+    if !declared.is_empty() {
+        x.push_str("  <TypeDefinitions>\n");
+        for e in ENUMERATIONS.iter().filter(|e| declared.contains(&e.name)) {
+            let _ = writeln!(
+                x,
+                "    <SimpleType name=\"{}\" description=\"{}\">\n      <Enumeration>",
+                a(e.name),
+                a(e.description)
+            );
+            for (k, (item, description)) in e.items.iter().enumerate() {
+                let _ = writeln!(
+                    x,
+                    "        <Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
+                    a(item),
+                    k + 1,
+                    a(description)
+                );
+            }
+            x.push_str("      </Enumeration>\n    </SimpleType>\n");
+        }
+        x.push_str("  </TypeDefinitions>\n");
+    }
+
     if !LOG_CATEGORIES.is_empty() {
         x.push_str("  <LogCategories>\n");
         for (name, description) in LOG_CATEGORIES {
@@ -215,6 +241,13 @@ pub fn model_description(
                 if let Some(max) = v.max {
                     let _ = write!(x, " max=\"{}\"", format_real(max));
                 }
+            }
+            VariableType::Integer if v.declared_type.is_some() => {
+                let _ = write!(
+                    x,
+                    "Enumeration declaredType=\"{}\"",
+                    a(v.declared_type.unwrap_or_default())
+                );
             }
             VariableType::Integer => {
                 x.push_str("Integer");
@@ -404,6 +437,7 @@ mod tests {
             [
                 "CoSimulation",
                 "UnitDefinitions",
+                "TypeDefinitions",
                 "LogCategories",
                 "DefaultExperiment",
                 "ModelVariables",
@@ -515,7 +549,13 @@ mod tests {
                         assert_eq!(typed.attributes["max"].parse::<f64>().unwrap(), max);
                     }
                 }
-                VariableType::Integer => assert_eq!(typed.name, "Integer"),
+                VariableType::Integer => match v.declared_type {
+                    Some(t) => {
+                        assert_eq!(typed.name, "Enumeration");
+                        assert_eq!(typed.attributes["declaredType"], t);
+                    }
+                    None => assert_eq!(typed.name, "Integer"),
+                },
                 VariableType::Boolean => {
                     assert_eq!(typed.name, "Boolean");
                     if v.causality != Causality::Output {

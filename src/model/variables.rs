@@ -42,9 +42,26 @@ pub struct FixedVariableSpec {
     pub causality: Causality,
     pub variability: Variability,
     pub unit: Option<&'static str>,
+    /// An Integer that is an FMI Enumeration of this declared type (see [`ENUMERATIONS`]).
+    pub declared_type: Option<&'static str>,
     pub min: Option<f64>,
     pub max: Option<f64>,
     pub description: &'static str,
+}
+
+/// An enumeration type: items valued 1, 2, ... in order.
+#[derive(Debug, Clone, Copy)]
+pub struct EnumerationSpec {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub items: &'static [(&'static str, &'static str)],
+}
+
+impl EnumerationSpec {
+    /// The enumeration called `name`.
+    pub fn by_name(name: &str) -> Option<&'static EnumerationSpec> {
+        ENUMERATIONS.iter().find(|e| e.name == name)
+    }
 }
 
 /// A unit with its SI base-unit exponents.
@@ -177,6 +194,8 @@ pub struct Variable {
     pub causality: Causality,
     pub variability: Variability,
     pub unit: Option<&'static str>,
+    /// For an Integer written as an FMI Enumeration: its declared type.
+    pub declared_type: Option<&'static str>,
     pub min: Option<f64>,
     pub max: Option<f64>,
     pub description: String,
@@ -202,6 +221,7 @@ impl VariableTable {
                 causality: s.causality,
                 variability: s.variability,
                 unit: s.unit,
+                declared_type: s.declared_type,
                 min: s.min,
                 max: s.max,
                 description: s.description.to_string(),
@@ -222,6 +242,7 @@ impl VariableTable {
                         causality: *causality,
                         variability: Variability::Continuous,
                         unit: Some(quantity.unit()),
+                        declared_type: None,
                         min: None,
                         max: None,
                         description: quantity.description(spec.kind).to_string(),

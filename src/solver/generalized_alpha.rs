@@ -20,6 +20,7 @@
 
 use super::cholesky::{SolveWorkspace, SparseCholesky};
 use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
+use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
 use crate::body::{Body, BodyKinematics, ForceScratch};
 use crate::error::{Error, Result};
@@ -146,11 +147,121 @@ pub struct IterationMatrix {
     workspace: SolveWorkspace,
     /// `Z = S̄⁻¹ Cᵀ` and the inverse Schur complement when there are point constraints.
     constraint: Option<ConstraintFactor>,
+    /// For the full formulation: the tangent, refactorised every iteration (Newton).
+    newton: Option<TangentMatrix>,
+    /// With `f_nl`: the rank-3 Woodbury correction of its Jacobian.
+    nonlinear: Option<NonlinearForceCorrection>,
+}
+
+/// Newton's iteration matrix of the full formulation, `S = c_m' M + c_k K_T(x)` on the free DOFs
+/// (`c_m' = c_m + c_d α`, `c_k = 1 + c_d β`: the damping enters with the linear `K`'s
+/// coefficients), reassembled from the tangent `K_T` at every iteration.
+pub struct TangentMatrix {
+    tangent: SymmetricCsr,
+    iteration: SymmetricCsr,
+    /// For each entry of `iteration`: its index in `tangent` and in `FreeNodes::mass` (or
+    /// `usize::MAX` where `M` has none).
+    tangent_index: Vec<usize>,
+    mass_index: Vec<usize>,
+    mass_coefficient: f64,
+    stiffness_coefficient: f64,
+}
+
+impl TangentMatrix {
+    fn new(
+        body: &Body,
+        free: &FreeNodes,
+        pattern: SymmetricCsr,
+        mass_coefficient: f64,
+        stiffness_coefficient: f64,
+    ) -> TangentMatrix {
+        let full = body.full.as_ref().expect("the full formulation");
+        let tangent = full.tangent_pattern();
+        let dofs: Vec<usize> = free
+            .nodes
+            .iter()
+            .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        let find = |m: &SymmetricCsr, row: usize, col: usize| {
+            let range = m.row_ptr[row]..m.row_ptr[row + 1];
+            m.col_idx[range.clone()]
+                .binary_search(&col)
+                .map(|k| range.start + k)
+                .unwrap_or(usize::MAX)
+        };
+        let mut tangent_index = Vec::with_capacity(pattern.nnz());
+        let mut mass_index = Vec::with_capacity(pattern.nnz());
+        for row in 0..pattern.n {
+            for k in pattern.row_ptr[row]..pattern.row_ptr[row + 1] {
+                let col = pattern.col_idx[k];
+                tangent_index.push(find(&tangent, dofs[row], dofs[col]));
+                mass_index.push(find(&free.mass, row, col));
+            }
+        }
+        TangentMatrix {
+            tangent,
+            iteration: pattern,
+            tangent_index,
+            mass_index,
+            mass_coefficient,
+            stiffness_coefficient,
+        }
+    }
+
+    /// Assembles `S` at positions `x` and refactorises `factor` numerically (symbolic reused).
+    fn refactor(
+        &mut self,
+        body: &Body,
+        free: &FreeNodes,
+        x: &[f64],
+        factor: &mut SparseCholesky,
+    ) -> Result<()> {
+        let full = body.full.as_ref().expect("the full formulation");
+        full.tangent_stiffness(x, &mut self.tangent);
+        self.fill(free);
+        if factor.refactor(&self.iteration).is_ok() {
+            return Ok(());
+        }
+        // An iterate far from equilibrium (e.g. the first one after a step load) can make the
+        // St. Venant–Kirchhoff tangent indefinite: this iteration uses the linear K instead
+        // (a modified-Newton step); the next one tries the tangent again.
+        self.tangent
+            .values
+            .copy_from_slice(&body.stiffness_matrix.values);
+        self.fill(free);
+        factor.refactor(&self.iteration).map_err(|e| {
+            Error::discard(format!(
+                "the iteration matrix of the full formulation is not positive definite ({})",
+                e.message
+            ))
+        })
+    }
+
+    /// `S = c_m' M + c_k K_T` on the free DOFs from the current `tangent`.
+    fn fill(&mut self, free: &FreeNodes) {
+        for (k, value) in self.iteration.values.iter_mut().enumerate() {
+            let t = self.tangent_index[k];
+            let m = self.mass_index[k];
+            *value = self.stiffness_coefficient
+                * if t == usize::MAX {
+                    0.0
+                } else {
+                    self.tangent.values[t]
+                }
+                + self.mass_coefficient
+                    * if m == usize::MAX {
+                        0.0
+                    } else {
+                        free.mass.values[m]
+                    };
+        }
+    }
 }
 
 impl IterationMatrix {
     /// Assembles and factorises `S̄` for step `h` (the only factorization of a run at this `h`).
     pub fn new(
+        body: &Body,
         free: &FreeNodes,
         scheme: &GeneralizedAlpha,
         h: f64,
@@ -166,6 +277,15 @@ impl IterationMatrix {
             &free.stiffness,
         );
         let factor = SparseCholesky::new(&s)?;
+        let newton = body.full.is_some().then(|| {
+            TangentMatrix::new(
+                body,
+                free,
+                s.clone(),
+                c_m + c_d * damping_alpha,
+                1.0 + c_d * damping_beta,
+            )
+        });
         let mut workspace = factor.solve_scratch();
         let constraint = if free.constraints.is_empty() {
             None
@@ -176,11 +296,15 @@ impl IterationMatrix {
                 &mut workspace,
             )?)
         };
+        let nonlinear = (body.options.nonlinear_forces && body.full.is_none())
+            .then(|| NonlinearForceCorrection::new(body, free, &factor, &mut workspace));
         Ok(IterationMatrix {
             step_size: h,
             factor,
             workspace,
             constraint,
+            newton,
+            nonlinear,
         })
     }
 }
@@ -235,6 +359,9 @@ pub struct StepWorkspace {
     reduced: Vec<f64>,
     force_scratch: ForceScratch,
     previous: DynamicState,
+    /// The geometric stiffness `K_G` of the current prestress (stiffening), if any: set by the
+    /// owner before a step, constant during it.
+    pub geometric_stiffness: Option<SymmetricCsr>,
 }
 
 impl StepWorkspace {
@@ -254,6 +381,7 @@ impl StepWorkspace {
                 pseudo_acceleration: vec![0.0; n3],
                 multipliers: vec![0.0; free.multiplier_count()],
             },
+            geometric_stiffness: None,
         }
     }
 }
@@ -270,6 +398,7 @@ pub fn residual(
     let kin = body.internal_force(
         &state.position,
         &state.velocity,
+        ws.geometric_stiffness.as_ref(),
         &mut ws.force_scratch,
         &mut ws.internal,
     );
@@ -385,7 +514,36 @@ fn iterate(
     let mut last_correction = f64::INFINITY;
     for iteration in 1..=settings.max_iterations {
         let kin = residual(body, free, state, loads, ws);
-        let r = kin.frame.rotation;
+        if let (1, Some(correction)) = (iteration, &mut matrix.nonlinear) {
+            // The f_nl Jacobian, frozen over the step at the predictor.
+            let h_inv = body
+                .frame_weights
+                .rotation_sensitivity(&kin.frame, &state.position)
+                .try_inverse()
+                .unwrap_or_else(nalgebra::Matrix3::zeros);
+            correction.update(
+                body,
+                free,
+                ws.force_scratch.local_deformation(),
+                ws.force_scratch.elastic_force(),
+                &h_inv,
+            );
+        }
+        // Reduced strain: the constant matrix in the co-moving frame. Full: Newton on the
+        // tangent at the current positions, in the global frame.
+        let r = if let Some(newton) = &mut matrix.newton {
+            newton.refactor(body, free, &state.position, &mut matrix.factor)?;
+            if matrix.constraint.is_some() {
+                matrix.constraint = Some(ConstraintFactor::new(
+                    &free.constraints,
+                    &matrix.factor,
+                    &mut matrix.workspace,
+                )?);
+            }
+            nalgebra::Matrix3::identity()
+        } else {
+            kin.frame.rotation
+        };
         let rt = r.transpose();
         // Rotate the free part of the residual into the co-moving frame, solve, rotate back.
         for (k, &i) in free.nodes.iter().enumerate() {
@@ -394,6 +552,9 @@ fn iterate(
         matrix
             .factor
             .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
+        if let Some(correction) = &matrix.nonlinear {
+            correction.correct(&mut ws.reduced);
+        }
         if let Some(constraint) = &mut matrix.constraint {
             constraint.correct(
                 &free.constraints,

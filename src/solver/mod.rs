@@ -3,5 +3,6 @@
 pub mod cholesky;
 pub mod constraints;
 pub mod generalized_alpha;
+pub mod woodbury;
 
 pub use cholesky::SparseCholesky;

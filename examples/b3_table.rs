@@ -1,0 +1,160 @@
+//! B3 (Kane's beam spun up on a hub) through the slave for each model choice: the table of
+//! issue 4. `cargo run --release --example b3_table [-- h]` (default h = 1e-2 s; `full` is also
+//! run at h/4 as the yardstick).
+//!
+//! Columns: tip deflection in the hub frame (m) at t = 2, 4, 6, 7, 8, 10, 12, 14 s, the peak and
+//! its time, the largest |deflection| after T_s = 15 s, iterations per step and wall time.
+
+use flexbody::model::{BodyFile, VariableType};
+use flexbody::slave::Slave;
+use nalgebra::{Rotation3, Vector3};
+use std::time::Instant;
+
+/// Hub angle and rate of B3.
+fn hub(t: f64) -> (f64, f64) {
+    let (omega, ts) = (6.0, 15.0);
+    let k = 2.0 * std::f64::consts::PI / ts;
+    if t < ts {
+        (
+            omega / ts * (t * t / 2.0 + ((k * t).cos() - 1.0) / (k * k)),
+            omega / ts * (t - (k * t).sin() / k),
+        )
+    } else {
+        (omega * (t - ts / 2.0), omega)
+    }
+}
+
+fn vr(s: &Slave, name: &str) -> u32 {
+    s.variables().by_name(name).unwrap().value_reference
+}
+
+/// A row of the table: label, step size and the Integer/Boolean settings.
+type Case = (String, f64, Vec<(&'static str, i32)>);
+
+struct Run {
+    samples: Vec<f64>,
+    peak: (f64, f64),
+    late: f64,
+    iterations: f64,
+    wall: f64,
+}
+
+fn run(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Result<Run, String> {
+    let mut s = Slave::from_body(body.clone()).map_err(|e| e.message)?;
+    s.setup_experiment(0.0, None, None).map_err(|e| e.message)?;
+    s.enter_initialization_mode().map_err(|e| e.message)?;
+    let step = vr(&s, "solver.stepSize");
+    s.set_real(step, h).map_err(|e| e.message)?;
+    for (name, value) in settings {
+        let v = s.variables().by_name(name).unwrap().clone();
+        match v.ty {
+            VariableType::Integer => s.set_integer(v.value_reference, *value),
+            VariableType::Boolean => s.set_boolean(v.value_reference, *value != 0),
+            VariableType::Real => s.set_real(v.value_reference, *value as f64),
+        }
+        .map_err(|e| e.message)?;
+    }
+    s.exit_initialization_mode().map_err(|e| e.message)?;
+    let rotation: Vec<u32> = (1..=9)
+        .map(|k| vr(&s, &format!("hub.rotation[{k}]")))
+        .collect();
+    let rate = vr(&s, "hub.angularVelocity[3]");
+    let tip: Vec<u32> = (1..=3)
+        .map(|k| vr(&s, &format!("tip.position[{k}]")))
+        .collect();
+    let times = [2.0, 4.0, 6.0, 7.0, 8.0, 10.0, 12.0, 14.0];
+    let mut samples = vec![f64::NAN; times.len()];
+    let (mut peak, mut late) = ((0.0, 0.0_f64), 0.0_f64);
+    let steps = (20.0 / h).round() as usize;
+    let started = Instant::now();
+    for k in 0..steps {
+        let t = k as f64 * h;
+        let (theta, omega) = hub(t);
+        let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
+        for (c, &r) in rotation.iter().enumerate() {
+            s.set_real(r, q.matrix()[(c / 3, c % 3)]).unwrap();
+        }
+        s.set_real(rate, omega).unwrap();
+        s.do_step(t, h)
+            .map_err(|e| format!("t = {t}: {}", e.message))?;
+        let t1 = t + h;
+        let p = Vector3::from_fn(|c, _| s.get_real(tip[c]).unwrap());
+        let y = (Rotation3::from_axis_angle(&Vector3::z_axis(), hub(t1).0).inverse() * p).y;
+        for (j, &ts) in times.iter().enumerate() {
+            if (t1 - ts).abs() < 0.5 * h {
+                samples[j] = y;
+            }
+        }
+        if y.abs() > peak.1.abs() {
+            peak = (t1, y);
+        }
+        if t1 > 15.0 {
+            late = late.max(y.abs());
+        }
+    }
+    let wall = started.elapsed().as_secs_f64();
+    let (internal, iterations) = s.solver_statistics();
+    Ok(Run {
+        samples,
+        peak,
+        late,
+        iterations: iterations as f64 / internal as f64,
+        wall,
+    })
+}
+
+fn main() {
+    let h: f64 = std::env::args()
+        .nth(1)
+        .and_then(|a| a.parse().ok())
+        .unwrap_or(1e-2);
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/hub_beam.json"
+    ))
+    .unwrap();
+    let body = BodyFile::from_json(&text).unwrap();
+    println!("B3, {} (h = {h} s unless stated)\n", body.description);
+    println!("| model | h (s) | y(2) | y(4) | y(6) | y(7) | y(8) | y(10) | y(12) | y(14) | peak (m) at t (s) | max after 15 s | iterations/step | wall (s) |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let stiffening = ["none", "inertial", "stress"];
+    let mut cases: Vec<Case> = Vec::new();
+    for f_nl in [0, 1] {
+        for (k, name) in stiffening.iter().enumerate() {
+            cases.push((
+                format!(
+                    "reduced strain, f_nl {}, stiffening {name}",
+                    if f_nl == 1 { "on" } else { "off" }
+                ),
+                h,
+                vec![
+                    ("model.nonlinearForces", f_nl),
+                    ("model.stiffening", k as i32 + 1),
+                ],
+            ));
+        }
+    }
+    cases.push(("full".into(), h, vec![("model.formulation", 2)]));
+    cases.push((
+        "full (yardstick)".into(),
+        h / 4.0,
+        vec![("model.formulation", 2)],
+    ));
+    for (label, h, settings) in cases {
+        match run(&body, h, &settings) {
+            Ok(r) => {
+                let y: Vec<String> = r.samples.iter().map(|v| format!("{v:+.4}")).collect();
+                println!(
+                    "| {label} | {h} | {} | {:+.4} at {:.2} | {:.4} | {:.2} | {:.1} |",
+                    y.join(" | "),
+                    r.peak.1,
+                    r.peak.0,
+                    r.late,
+                    r.iterations,
+                    r.wall
+                );
+            }
+            Err(e) => println!("| {label} | {h} | not run: {e} |"),
+        }
+    }
+}

@@ -1,0 +1,178 @@
+//! Geometric stiffening of the reduced-strain body (DESIGN.md section 2):
+//! `f_stiff = hR K_G(S0) ū` with the prestress `S0` either
+//!
+//! * `inertial`: the static stress of the co-moving frame's rigid acceleration field
+//!   `a(X) = c̈ + α × X̄ + ω × (ω × X̄)` (body axes), linear in the 12 coefficients
+//!   `c̈` (3), `α` (3) and `ω_a ω_b` (6, a ≤ b): `K_G = Σ_k c_k K_G,k` with the 12 unit load cases
+//!   (body force `−ρ a_k`, clamped nodes held) precomputed once;
+//! * `stress`: the stress of the current local deformation, `S0 = D : sym ∇ū`, `K_G` reassembled.
+//!
+//! Either way `K_G` is refreshed once per communication step and held during it.
+
+use super::frame::{node, set_node};
+use super::Body;
+use crate::error::{Error, Result};
+use crate::fem::geometric::{
+    gauss_point_count, geometric_stiffness, geometric_stiffness_into, stiffness_pattern,
+    stress_at_gauss_points, stress_at_gauss_points_into, weighted_sum_into,
+};
+use crate::fem::{IsotropicMaterial, SymmetricCsr};
+use crate::mesh::Mesh;
+use crate::solver::SparseCholesky;
+use nalgebra::{Matrix3, Vector3};
+
+/// Which prestress drives the stiffening.
+#[derive(Debug, Clone)]
+pub enum Stiffening {
+    /// The 12 unit load cases' geometric stiffnesses.
+    Inertial { unit_cases: Vec<SymmetricCsr> },
+    /// Gauss-point stresses and the local deformation (scratch).
+    Stress {
+        stresses: Vec<[f64; 6]>,
+        local_deformation: Vec<f64>,
+    },
+}
+
+/// The unit rigid acceleration field `k` (0..12) at the reference offset `xb`.
+fn unit_field(k: usize, xb: &Vector3<f64>) -> Vector3<f64> {
+    let e = |j: usize| Vector3::ith(j, 1.0);
+    match k {
+        0..=2 => e(k),
+        3..=5 => e(k - 3).cross(xb),
+        _ => {
+            // ω × (ω × X̄) = Σ_{a≤b} ω_a ω_b T_ab(X̄): T_aa = e_a X̄_a − X̄,
+            // T_ab = e_a X̄_b + e_b X̄_a (a < b).
+            let (a, b) = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)][k - 6];
+            if a == b {
+                e(a) * xb[a] - xb
+            } else {
+                e(a) * xb[b] + e(b) * xb[a]
+            }
+        }
+    }
+}
+
+impl Stiffening {
+    /// `inertial` stiffening for `body` held at its `clamped` nodes (error for an unsupported
+    /// body: its unit load cases would need inertia relief, which is not implemented).
+    pub fn inertial(
+        mesh: &Mesh,
+        material: &IsotropicMaterial,
+        body: &Body,
+        clamped: &[bool],
+    ) -> Result<Stiffening> {
+        let free: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
+        if free.len() == body.node_count() {
+            return Err(Error::new(
+                "model.stiffening = inertial needs a fixed support or a motion interface (an unsupported body would need inertia relief)",
+            ));
+        }
+        let dofs: Vec<usize> = free
+            .iter()
+            .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect();
+        let factor = SparseCholesky::new(&body.stiffness_matrix.submatrix(&dofs))?;
+        let mut workspace = factor.solve_scratch();
+        let fw = &body.frame_weights;
+        let n3 = body.reference.len();
+        let (mut field, mut load) = (vec![0.0; n3], vec![0.0; n3]);
+        let mut unit_cases = Vec::with_capacity(12);
+        for k in 0..12 {
+            for i in 0..body.node_count() {
+                set_node(&mut field, i, &unit_field(k, &fw.reference_offsets[i]));
+            }
+            body.mass_times(&field, &mut load); // M a_k; the body force is −M a_k
+            let mut rhs: Vec<f64> = dofs.iter().map(|&d| -load[d]).collect();
+            factor.solve_in_place(&mut rhs, &mut workspace);
+            let mut u = vec![0.0; n3];
+            for (&d, v) in dofs.iter().zip(&rhs) {
+                u[d] = *v;
+            }
+            unit_cases.push(geometric_stiffness(
+                mesh,
+                &stress_at_gauss_points(mesh, material, &u),
+            ));
+        }
+        Ok(Stiffening::Inertial { unit_cases })
+    }
+
+    /// `stress` stiffening.
+    pub fn stress(mesh: &Mesh, body: &Body) -> Stiffening {
+        Stiffening::Stress {
+            stresses: vec![[0.0; 6]; gauss_point_count(mesh)],
+            local_deformation: vec![0.0; body.reference.len()],
+        }
+    }
+
+    /// A matrix with the pattern of `K_G`.
+    pub fn pattern(mesh: &Mesh) -> SymmetricCsr {
+        stiffness_pattern(mesh)
+    }
+
+    /// Refreshes `k_g` for the state `(x, v, a)` (flat 3N).
+    #[allow(clippy::too_many_arguments)]
+    pub fn update(
+        &mut self,
+        mesh: &Mesh,
+        material: &IsotropicMaterial,
+        body: &Body,
+        x: &[f64],
+        v: &[f64],
+        a: &[f64],
+        k_g: &mut SymmetricCsr,
+    ) {
+        let fw = &body.frame_weights;
+        let frame = fw.best_fit(x);
+        let rt = frame.rotation.transpose();
+        match self {
+            Stiffening::Inertial { unit_cases } => {
+                // The frame's rigid acceleration field in body axes: c̈, ω (from H), α (least
+                // squares of the acceleration field about c, centripetal part removed).
+                let h_inv = fw
+                    .rotation_sensitivity(&frame, x)
+                    .try_inverse()
+                    .unwrap_or_else(Matrix3::zeros);
+                let omega = fw.angular_velocity(&frame, &h_inv, v);
+                let c_ddot = rt * fw.centroid(a);
+                let mut j = Matrix3::zeros();
+                let mut b = Vector3::zeros();
+                for ((&n, &w), xb) in fw.nodes.iter().zip(&fw.weights).zip(&fw.reference_offsets) {
+                    let r = rt * (node(x, n) - frame.origin);
+                    let ai = rt * node(a, n) - c_ddot - omega.cross(&omega.cross(xb));
+                    j += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
+                    b += w * r.cross(&ai);
+                }
+                let alpha = j.try_inverse().unwrap_or_else(Matrix3::zeros) * b;
+                let w = omega;
+                let c = [
+                    c_ddot.x,
+                    c_ddot.y,
+                    c_ddot.z,
+                    alpha.x,
+                    alpha.y,
+                    alpha.z,
+                    w.x * w.x,
+                    w.y * w.y,
+                    w.z * w.z,
+                    w.x * w.y,
+                    w.x * w.z,
+                    w.y * w.z,
+                ];
+                let terms: [(f64, &SymmetricCsr); 12] =
+                    std::array::from_fn(|k| (c[k], &unit_cases[k]));
+                weighted_sum_into(k_g, &terms);
+            }
+            Stiffening::Stress {
+                stresses,
+                local_deformation,
+            } => {
+                for i in 0..body.node_count() {
+                    let u = rt * (node(x, i) - frame.origin) - fw.reference_offsets[i];
+                    set_node(local_deformation, i, &u);
+                }
+                stress_at_gauss_points_into(mesh, material, local_deformation, stresses);
+                geometric_stiffness_into(mesh, stresses, k_g);
+            }
+        }
+    }
+}
