@@ -159,6 +159,36 @@ pub fn scalar_mass_matrix(mesh: &Mesh, density: f64) -> SymmetricCsr {
     }
 }
 
+/// The sparsity pattern of [`stiffness_matrix`] with all values zero: row `3i+d` holds columns
+/// `3j, 3j+1, 3j+2` for every node `j` sharing an element with node `i` (including `i`),
+/// ascending. Every `3N × 3N` matrix of a mesh (`K`, `K_G`, the tangent) has this pattern.
+pub fn stiffness_pattern(mesh: &Mesh) -> SymmetricCsr {
+    displacement_pattern(&NodeGraph::new(mesh))
+}
+
+/// Row `3i+d` holds columns `3j+e` for every neighbour `j` of `i` and `e = 0, 1, 2`.
+fn displacement_pattern(graph: &NodeGraph) -> SymmetricCsr {
+    let node_count = graph.row_ptr.len() - 1;
+    let mut row_ptr = Vec::with_capacity(3 * node_count + 1);
+    row_ptr.push(0);
+    let mut col_idx = Vec::with_capacity(9 * graph.neighbours.len());
+    for i in 0..node_count {
+        let neighbours = &graph.neighbours[graph.row_ptr[i]..graph.row_ptr[i + 1]];
+        for _ in 0..3 {
+            for &j in neighbours {
+                col_idx.extend_from_slice(&[3 * j, 3 * j + 1, 3 * j + 2]);
+            }
+            row_ptr.push(col_idx.len());
+        }
+    }
+    SymmetricCsr {
+        n: 3 * node_count,
+        values: vec![0.0; col_idx.len()],
+        row_ptr,
+        col_idx,
+    }
+}
+
 /// The small-strain stiffness `K = ∫ Bᵀ D B dV` (N/m), `3N × 3N`, DOF `3 * node + direction`.
 ///
 /// For the isotropic `D` of [`IsotropicMaterial::elasticity_matrix`] the 3×3 block coupling
@@ -172,21 +202,12 @@ pub fn stiffness_matrix(mesh: &Mesh, material: &IsotropicMaterial) -> SymmetricC
     let lambda = material.lame_lambda();
     let mu = material.shear_modulus();
     let node_count = mesh.node_count();
-
-    // Pattern: row 3i+d holds columns 3j+e for every neighbour j of i and e = 0, 1, 2.
-    let mut row_ptr = Vec::with_capacity(3 * node_count + 1);
-    row_ptr.push(0);
-    let mut col_idx = Vec::with_capacity(9 * graph.neighbours.len());
-    for i in 0..node_count {
-        let neighbours = &graph.neighbours[graph.row_ptr[i]..graph.row_ptr[i + 1]];
-        for _ in 0..3 {
-            for &j in neighbours {
-                col_idx.extend_from_slice(&[3 * j, 3 * j + 1, 3 * j + 2]);
-            }
-            row_ptr.push(col_idx.len());
-        }
-    }
-    let mut values = vec![0.0; col_idx.len()];
+    let SymmetricCsr {
+        row_ptr,
+        col_idx,
+        mut values,
+        ..
+    } = displacement_pattern(&graph);
 
     let mut coords = [[0.0; 3]; MAX_NODES];
     let mut gradients = [[0.0; 3]; MAX_NODES];

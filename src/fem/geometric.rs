@@ -25,6 +25,7 @@
 //! keeps `K`'s pattern, and [`weighted_sum_into`] can combine `K`, `K_G` and precomputed unit
 //! cases value by value without looking at indices.
 
+pub use super::assembly::stiffness_pattern;
 use super::element::{full_integration_points, physical_gradients, shape_functions, MAX_NODES};
 use super::quadrature::hexahedron_rule;
 use super::{IsotropicMaterial, SymmetricCsr};
@@ -143,56 +144,6 @@ pub fn stress_at_gauss_points_into(
                 mu * (grad[0][1] + grad[1][0]),
             ];
         }
-    }
-}
-
-/// The sparsity pattern of [`stiffness_matrix`](super::stiffness_matrix) with all values zero:
-/// row `3i+d` holds columns `3j, 3j+1, 3j+2` for every node `j` sharing an element with node `i`
-/// (including `i`), ascending.
-pub fn stiffness_pattern(mesh: &Mesh) -> SymmetricCsr {
-    let node_count = mesh.node_count();
-    // Elements of each node (CSR).
-    let mut element_ptr = vec![0usize; node_count + 1];
-    for e in 0..mesh.element_count() {
-        for &i in mesh.element(e) {
-            element_ptr[i + 1] += 1;
-        }
-    }
-    for i in 0..node_count {
-        element_ptr[i + 1] += element_ptr[i];
-    }
-    let mut fill = element_ptr.clone();
-    let mut elements = vec![0usize; element_ptr[node_count]];
-    for e in 0..mesh.element_count() {
-        for &i in mesh.element(e) {
-            elements[fill[i]] = e;
-            fill[i] += 1;
-        }
-    }
-    let mut row_ptr = Vec::with_capacity(3 * node_count + 1);
-    row_ptr.push(0);
-    let mut col_idx = Vec::new();
-    let mut neighbours = Vec::new();
-    for i in 0..node_count {
-        neighbours.clear();
-        for &e in &elements[element_ptr[i]..element_ptr[i + 1]] {
-            neighbours.extend_from_slice(mesh.element(e));
-        }
-        neighbours.sort_unstable();
-        neighbours.dedup();
-        for _ in 0..3 {
-            for &j in &neighbours {
-                col_idx.extend_from_slice(&[3 * j, 3 * j + 1, 3 * j + 2]);
-            }
-            row_ptr.push(col_idx.len());
-        }
-    }
-    let values = vec![0.0; col_idx.len()];
-    SymmetricCsr {
-        n: 3 * node_count,
-        row_ptr,
-        col_idx,
-        values,
     }
 }
 
