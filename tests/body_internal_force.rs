@@ -9,9 +9,13 @@ use flexbody::mesh::{self, ElementKind};
 use nalgebra::{Rotation3, Vector3};
 
 fn small_beam(options: BodyOptions) -> Body {
+    beam_of(options, 2.1e11)
+}
+
+fn beam_of(options: BodyOptions, youngs_modulus: f64) -> Body {
     let mesh = mesh::beam(0.4, 0.05, 0.03, [4, 1, 1], ElementKind::Hex20).unwrap();
     let material = IsotropicMaterial {
-        youngs_modulus: 2.1e11,
+        youngs_modulus,
         poisson_ratio: 0.3,
         density: 7850.0,
     };
@@ -167,4 +171,44 @@ fn damping_leaves_rigid_motion_of_a_deformed_body_undamped() {
         power > 0.0,
         "damping must dissipate: power of f_d = {power:e}"
     );
+}
+
+/// The mass-proportional damping acts on the velocity relative to its kinetic-energy-nearest
+/// rigid motion: for any velocity field it has no net force and no net moment (so it neither
+/// brakes nor spins the body) and it dissipates. (A body of E = 1 Pa, so that the elastic forces
+/// do not drown the damping force in round-off when the two are told apart.)
+#[test]
+fn mass_proportional_damping_has_no_net_force_or_moment_and_dissipates() {
+    let damped = beam_of(
+        BodyOptions {
+            damping_alpha: 5.0,
+            ..BodyOptions::default()
+        },
+        1.0,
+    );
+    let undamped = beam_of(BodyOptions::default(), 1.0);
+    let x = rotated_deformed(&damped);
+    let mut v = vec![0.0; x.len()];
+    for (k, value) in v.iter_mut().enumerate() {
+        *value = (0.7 * k as f64).sin() + 0.3 * (1.3 * k as f64).cos();
+    }
+    let mut scratch = damped.force_scratch();
+    let (mut fd, mut f0) = (vec![0.0; x.len()], vec![0.0; x.len()]);
+    damped.internal_force(&x, &v, None, &mut scratch, &mut fd);
+    undamped.internal_force(&x, &v, None, &mut scratch, &mut f0);
+    let (mut force, mut moment, mut scale) = (Vector3::zeros(), Vector3::zeros(), 0.0_f64);
+    let mut power = 0.0;
+    for i in 0..damped.node_count() {
+        let f = node(&fd, i) - node(&f0, i);
+        force += f;
+        moment += node(&x, i).cross(&f);
+        scale = scale.max(f.norm() * node(&x, i).norm().max(1.0));
+        power += f.dot(&node(&v, i));
+    }
+    assert!(force.norm() < 1e-12 * scale, "net damping force {force:?}");
+    assert!(
+        moment.norm() < 1e-12 * scale,
+        "net damping moment {moment:?}"
+    );
+    assert!(power > 0.0, "power {power}");
 }

@@ -177,8 +177,8 @@ impl Body {
     /// * if `nonlinear_forces`: `f_nl,i = −w_i R (X̄_i × z)`, `z = H⁻ᵀ m̄`, `m̄ = Σ ū_i × g_i`,
     ///   `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×`: with it `f_int` is the exact gradient of
     ///   `V = ½ ūᵀ K ū`;
-    /// * damping `f_d = hR (α Ms⊗I3 + β K) dū/dt`, `dū_i/dt = Rᵀ(ẋ_i − ċ) − ω̄ × (X̄_i + ū_i)`,
-    ///   zero for any rigid motion.
+    /// * damping `f_d = hR β K dū/dt + α M (ẋ − v_r)`, `dū_i/dt = Rᵀ(ẋ_i − ċ) − ω̄ × (X̄_i + ū_i)`,
+    ///   `v_r` the rigid part of `ẋ` (see [`Body::rigid_velocity`]): zero for any rigid motion.
     ///
     /// `geometric_stiffness`, when given, adds the stiffening force `f_stiff = hR K_G ū`
     /// (DESIGN.md section 2) with `K_G` of the current prestress.
@@ -235,10 +235,24 @@ impl Body {
                 fd.fill(0.0);
             }
             if alpha != 0.0 {
+                // α M (ẋ − v_r) with v_r the M-orthogonal projection of ẋ on the rigid motions
+                // (consistent-mass centre and inertia): no net force or moment, so rigid motion
+                // is not damped, and ẋᵀ f = α (ẋ − v_r)ᵀ M (ẋ − v_r) ≥ 0 always dissipates.
+                // (Weighting the relative velocity by the frame's HRZ weights instead leaves a
+                // net force that can feed a slow oscillation of a driven body.)
+                let (centre, velocity, omega) = self.rigid_velocity(x, v, &mut scratch.mass_times);
+                let relative = &mut scratch.deformation_rate;
+                for i in 0..n {
+                    let vr = velocity + omega.cross(&(node(x, i) - centre));
+                    set_node(relative, i, &(node(v, i) - vr));
+                }
                 let mt = &mut scratch.mass_times;
-                self.mass_times(rate, mt);
-                for (v, m) in fd.iter_mut().zip(mt.iter()) {
-                    *v += alpha * m;
+                self.mass_times(relative, mt);
+                for i in 0..n {
+                    let local = rt * (alpha * node(mt, i));
+                    for d in 0..3 {
+                        fd[3 * i + d] += local[d];
+                    }
                 }
             }
         }
@@ -288,6 +302,40 @@ impl Body {
         for (i, &m) in self.mass_row_sums.iter().enumerate() {
             add_node(f, i, &(m * a));
         }
+    }
+
+    /// The rigid motion closest to the velocities `v` in the kinetic-energy norm: centre of mass
+    /// `x_c`, its velocity `V` and `ω = I⁻¹ L` (consistent mass, current configuration), so that
+    /// `v − (V + ω × (x − x_c))` carries no momentum and no angular momentum. `mv` is scratch
+    /// (3N). No allocation.
+    pub fn rigid_velocity(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        mv: &mut [f64],
+    ) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+        let m = self.total_mass;
+        let (mut centre, mut velocity) = (Vector3::zeros(), Vector3::zeros());
+        for (i, &w) in self.mass_row_sums.iter().enumerate() {
+            centre += w * node(x, i);
+            velocity += w * node(v, i);
+        }
+        centre /= m;
+        velocity /= m;
+        self.mass_times(v, mv);
+        let ms = &self.mass_matrix;
+        let (mut momentum, mut inertia) = (Vector3::zeros(), Matrix3::zeros());
+        for i in 0..ms.n {
+            let ri = node(x, i) - centre;
+            momentum += ri.cross(&node(mv, i));
+            for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
+                let rj = node(x, ms.col_idx[k]) - centre;
+                inertia += ms.values[k] * (Matrix3::identity() * ri.dot(&rj) - ri * rj.transpose());
+            }
+        }
+        let inertia = 0.5 * (inertia + inertia.transpose());
+        let omega = inertia.try_inverse().unwrap_or_else(Matrix3::zeros) * momentum;
+        (centre, velocity, omega)
     }
 
     /// `y = K x` (3×3-block product, no allocation).
