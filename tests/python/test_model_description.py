@@ -16,6 +16,17 @@ def test_fmpy_finds_no_problems(fmu_path):
     assert validate_fmu(fmu_path) == []
 
 
+def test_fmpy_finds_no_problems_in_the_motion_driven_fmu(driven_fmu_path, driven_model_description):
+    # Motion inputs (rotation start = identity, position start = the reference point) and the
+    # enumerations model.formulation / model.stiffening with their TypeDefinitions.
+    assert validate_fmu(driven_fmu_path) == []
+    starts = {v.name: v.start for v in driven_model_description.modelVariables}
+    assert [float(starts[f"root.rotation[{k}]"]) for k in range(1, 10)] == [1, 0, 0, 0, 1, 0, 0, 0, 1]
+    types = {t.name: [item.name for item in t.items] for t in driven_model_description.typeDefinitions}
+    assert types["Formulation"] == ["reducedStrain", "full"]
+    assert types["Stiffening"] == ["none", "inertial", "stress"]
+
+
 def test_archive_layout(fmu_path):
     with zipfile.ZipFile(fmu_path) as fmu:
         names = set(fmu.namelist())
