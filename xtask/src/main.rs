@@ -91,7 +91,11 @@ fn fmu_task(args: &[String]) -> Result<()> {
 /// `cargo xtask test [--python-only] [PYTEST ARGS...]`.
 fn test_task(args: &[String]) -> Result<()> {
     let python_only = args.iter().any(|a| a == "--python-only");
-    let pytest_args: Vec<&String> = args.iter().filter(|a| *a != "--python-only").collect();
+    // `cargo xtask test -- -k state` passes a `--` through: it only separates, pytest gets the rest.
+    let pytest_args: Vec<&String> = args
+        .iter()
+        .filter(|a| *a != "--python-only" && *a != "--")
+        .collect();
     let workspace = Workspace::locate()?;
     if !python_only {
         println!("xtask test: Rust tests (cargo test --workspace)");
