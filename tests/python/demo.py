@@ -34,7 +34,7 @@ def main():
     args = parser.parse_args()
 
     md = read_model_description(args.fmu)
-    print(f"{md.modelName}: {md.description}")
+    print(f"{md.modelName}: {md.description}" if md.description else md.modelName)
     print(f"step load tip.force[2] = {-LOAD} N at t = {T_STEP} s, damping.beta = {BETA} s, "
           f"communication step {H} s, until t = {T_END} s")
     wall = time.perf_counter()
@@ -56,7 +56,7 @@ def main():
     print(f"{'t (s)':>8}  {'tip displacement y (mm)':>24}  {'root force y (N)':>17}")
     for t_row in [0.0, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0]:
         k = int(np.argmin(np.abs(t - t_row)))
-        print(f"{t[k]:8.3f}  {deflection[k] * 1e3:24.5f}  {reaction[k]:17.4f}")
+        print(f"{t[k]:8.3f}  {deflection[k] * 1e3 + 0.0:24.5f}  {reaction[k] + 0.0:17.4f}")
 
     settled = deflection[-1]
     error = (abs(settled) - TIMOSHENKO_DEFLECTION) / TIMOSHENKO_DEFLECTION
@@ -78,7 +78,7 @@ def main():
     ax2.axhline(LOAD, color="k", linestyle="--", label="static reaction")
     ax2.set_xlabel("time (s)")
     ax2.set_ylabel("root reaction y (N)")
-    ax2.legend(loc="lower right")
+    ax2.legend(loc="center right")
     ax2.grid(True)
     fig.suptitle(f"flexbody {md.modelName}: {-LOAD} N step at the tip, damping.beta = {BETA} s")
     fig.tight_layout()

@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
+from fmpy.fmi2 import fmi2Warning
 
 from flexbody_fmu import Instance, step_input
 
@@ -81,6 +82,27 @@ def test_restored_state_reproduces_the_steps_bit_for_bit(unzipdir, model_descrip
         slave.time = t_saved
         assert first.tobytes() == slave.step(H, 20).tobytes()
         slave.fmu.freeFMUstate(state)
+        # Normal operation logs no warning or worse (OMSimulator treats fmi2Warning as an error).
+        assert [r for r in slave.messages() if r.status >= fmi2Warning] == []
+    finally:
+        slave.free()
+
+
+def test_uneven_and_jittered_communication_steps(unzipdir, model_description):
+    # canHandleVariableCommunicationStepSize: steps that are not multiples of solver.stepSize, and
+    # communication points accumulated as t += h (OMSimulator, fmuCheck), a few ulps off k h.
+    slave = Instance(unzipdir, model_description, "steps")
+    try:
+        slave.initialize({"damping.beta": 1e-4})
+        slave.set("tip.force[2]", -LOAD)
+        t = 0.0
+        for h in [0.5e-3, 2.5e-3, 1e-3, 0.3e-3, 1.7e-3] + [1e-3] * 30:
+            slave.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h,
+                             noSetFMUStatePriorToCurrentPoint=True)
+            t += h
+        assert np.all(np.isfinite(slave.outputs()))
+        assert slave.get("tip.position[2]") < 0.0  # it moved, the way it was pushed
+        assert [r for r in slave.messages() if r.status >= fmi2Warning] == []
     finally:
         slave.free()
 

@@ -10,6 +10,8 @@
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
+//! * `venv`: only the pinned Python environment; prints its interpreter.
+//!
 //! Only `std::process::Command` and the zip crate: no shell, no build scripts of our own.
 
 mod fmu;
@@ -34,7 +36,8 @@ tasks:
                                     (ARGS go to pytest; --python-only skips the Rust tests)
   demo                              simulate the default cantilever with fmpy, print a table,
                                     compare with the Timoshenko deflection, plot to
-                                    <target>/demo/cantilever.png";
+                                    <target>/demo/cantilever.png
+  venv                              set up the pinned venv only and print its python";
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
         "fmu" => fmu_task(rest),
         "test" => test_task(rest),
         "demo" => demo_task(rest),
+        "venv" => venv_task(rest),
         "-h" | "--help" | "help" => {
             println!("{USAGE}");
             Ok(())
@@ -89,7 +93,11 @@ fn fmu_task(args: &[String]) -> Result<()> {
 /// `cargo xtask test [--python-only] [PYTEST ARGS...]`.
 fn test_task(args: &[String]) -> Result<()> {
     let python_only = args.iter().any(|a| a == "--python-only");
-    let pytest_args: Vec<&String> = args.iter().filter(|a| *a != "--python-only").collect();
+    // `cargo xtask test -- -k state` passes a `--` through: it only separates, pytest gets the rest.
+    let pytest_args: Vec<&String> = args
+        .iter()
+        .filter(|a| *a != "--python-only" && *a != "--")
+        .collect();
     let workspace = Workspace::locate()?;
     if !python_only {
         println!("xtask test: Rust tests (cargo test --workspace)");
@@ -133,6 +141,16 @@ fn demo_task(args: &[String]) -> Result<()> {
         .arg(&plot)
         .env("MPLBACKEND", "Agg");
     run(&mut demo)
+}
+
+/// `cargo xtask venv`: for running pytest or the demo by hand.
+fn venv_task(args: &[String]) -> Result<()> {
+    if let Some(arg) = args.first() {
+        return Err(format!("unexpected argument '{arg}'\n{USAGE}"));
+    }
+    let python = venv::ensure(&Workspace::locate()?)?;
+    println!("{}", python.display());
+    Ok(())
 }
 
 /// Where things are: the workspace root (sources) and cargo's target directory (outputs).
