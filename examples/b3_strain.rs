@@ -12,19 +12,9 @@ use flexbody::fem::IsotropicMaterial;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::{Rotation3, Vector3};
-
-fn hub(t: f64) -> (f64, f64) {
-    let (omega, ts) = (6.0, 15.0);
-    let k = 2.0 * std::f64::consts::PI / ts;
-    if t < ts {
-        (
-            omega / ts * (t * t / 2.0 + ((k * t).cos() - 1.0) / (k * k)),
-            omega / ts * (t - (k * t).sin() / k),
-        )
-    } else {
-        (omega * (t - ts / 2.0), omega)
-    }
-}
+#[path = "../tests/common/b3.rs"]
+mod b3;
+use b3::hub;
 
 fn main() {
     let args: Vec<f64> = std::env::args()

@@ -9,20 +9,9 @@ use flexbody::model::{BodyFile, VariableType};
 use flexbody::slave::Slave;
 use nalgebra::{Rotation3, Vector3};
 use std::time::Instant;
-
-/// Hub angle and rate of B3.
-fn hub(t: f64) -> (f64, f64) {
-    let (omega, ts) = (6.0, 15.0);
-    let k = 2.0 * std::f64::consts::PI / ts;
-    if t < ts {
-        (
-            omega / ts * (t * t / 2.0 + ((k * t).cos() - 1.0) / (k * k)),
-            omega / ts * (t - (k * t).sin() / k),
-        )
-    } else {
-        (omega * (t - ts / 2.0), omega)
-    }
-}
+#[path = "../tests/common/b3.rs"]
+mod b3;
+use b3::hub;
 
 fn vr(s: &Slave, name: &str) -> u32 {
     s.variables().by_name(name).unwrap().value_reference

@@ -20,14 +20,6 @@ const CONVERGED_3D: f64 = 0.9987 * EULER_BERNOULLI;
 /// First bending frequency (Hz), Euler–Bernoulli.
 const FIRST_BENDING_HZ: f64 = 16.71;
 
-fn steel() -> IsotropicMaterial {
-    IsotropicMaterial {
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: 7850.0,
-    }
-}
-
 fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
     NodeSelector::Plane {
         point: [x, 0.0, 0.0],
@@ -49,7 +41,7 @@ fn free_dofs(mesh: &Mesh) -> Vec<usize> {
 
 /// Static tip deflection (m, positive downwards) of B1 on `mesh`.
 fn tip_deflection(mesh: &Mesh) -> f64 {
-    let material = steel();
+    let material = IsotropicMaterial::STEEL;
     let k = stiffness_matrix(mesh, &material);
     let lumped = lumped_masses(mesh, material.density);
     let tip = face(mesh, LENGTH);
@@ -134,7 +126,7 @@ fn hex8_converges_slowly_because_of_shear_locking() {
 #[test]
 fn first_bending_frequencies_within_1_percent() {
     let mesh = b1([20, 2, 2], ElementKind::Hex20);
-    let material = steel();
+    let material = IsotropicMaterial::STEEL;
     let free = free_dofs(&mesh);
     let k = stiffness_matrix(&mesh, &material).submatrix(&free);
     let m = scalar_mass_matrix(&mesh, material.density)

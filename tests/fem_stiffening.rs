@@ -41,14 +41,6 @@ const LENGTH: f64 = 1.0;
 const SIDE: f64 = 0.02;
 const AREA: f64 = SIDE * SIDE;
 
-fn steel() -> IsotropicMaterial {
-    IsotropicMaterial {
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: 7850.0,
-    }
-}
-
 /// Second moment of area `a⁴/12` (m⁴).
 fn second_moment() -> f64 {
     SIDE.powi(4) / 12.0
@@ -56,12 +48,12 @@ fn second_moment() -> f64 {
 
 /// Euler buckling load of the pinned–pinned beam, `π² E I / L²` (N): 27.63 kN.
 fn euler_load() -> f64 {
-    PI * PI * steel().youngs_modulus * second_moment() / (LENGTH * LENGTH)
+    PI * PI * IsotropicMaterial::STEEL.youngs_modulus * second_moment() / (LENGTH * LENGTH)
 }
 
 /// String–beam formula `ω₁² = (π/L)² (P_E + T) / (ρA)` (1/s²), `T` tension positive (N).
 fn formula_omega_squared(tension: f64) -> f64 {
-    (PI / LENGTH).powi(2) * (euler_load() + tension) / (steel().density * AREA)
+    (PI / LENGTH).powi(2) * (euler_load() + tension) / (IsotropicMaterial::STEEL.density * AREA)
 }
 
 /// The beam, its constant matrices and its free DOFs.
@@ -77,7 +69,7 @@ struct Beam {
 impl Beam {
     fn new(divisions: [usize; 3]) -> Beam {
         let mesh = beam(LENGTH, SIDE, SIDE, divisions, ElementKind::Hex20).unwrap();
-        let material = steel();
+        let material = IsotropicMaterial::STEEL;
         let k = stiffness_matrix(&mesh, &material);
         let m = scalar_mass_matrix(&mesh, material.density).kron_i3();
         let tol = 1e-9;
@@ -185,7 +177,7 @@ impl Beam {
     /// solution under the pre-load `T`.
     fn prestressed_stiffness(&self, tension: f64) -> SymmetricCsr {
         let u = self.preload_displacement(tension);
-        let stress = stress_at_gauss_points(&self.mesh, &steel(), &u);
+        let stress = stress_at_gauss_points(&self.mesh, &IsotropicMaterial::STEEL, &u);
         let k_g = geometric_stiffness(&self.mesh, &stress);
         let mut sum = self.k.clone();
         weighted_sum_into(&mut sum, &[(1.0, &self.k), (1.0, &k_g)]);
@@ -220,7 +212,7 @@ fn preload_stress_is_the_uniform_uniaxial_field() {
     let beam = Beam::new([10, 2, 2]);
     let tension = euler_load();
     let u = beam.preload_displacement(tension);
-    let stress = stress_at_gauss_points(&beam.mesh, &steel(), &u);
+    let stress = stress_at_gauss_points(&beam.mesh, &IsotropicMaterial::STEEL, &u);
     let sigma = tension / AREA;
     for s in &stress {
         assert!((s[0] / sigma - 1.0).abs() < 1e-9, "{s:?}");
@@ -294,7 +286,7 @@ fn lowest_eigenvalue_of_k_plus_kg_crosses_zero_at_the_euler_load() {
         let u = beam.preload_displacement(-p_e);
         geometric_stiffness(
             &beam.mesh,
-            &stress_at_gauss_points(&beam.mesh, &steel(), &u),
+            &stress_at_gauss_points(&beam.mesh, &IsotropicMaterial::STEEL, &u),
         )
     };
     let mut k_plus_g = beam.k.clone();

@@ -4,23 +4,9 @@
 //! lag during the spin-up and return to a small oscillation about zero at constant speed.
 
 mod common;
+use common::b3::hub;
 use common::*;
 use nalgebra::{Rotation3, Vector3};
-
-/// Hub angle, rate and acceleration of B3: `θ = Ω/T (t²/2 + (T/2π)² (cos(2πt/T) − 1))` for
-/// t < T = 15 s, then `Ω (t − T/2)`, Ω = 6 rad/s.
-fn hub(t: f64) -> (f64, f64) {
-    let (omega, ts) = (6.0, 15.0);
-    let k = 2.0 * std::f64::consts::PI / ts;
-    if t < ts {
-        (
-            omega / ts * (t * t / 2.0 + ((k * t).cos() - 1.0) / (k * k)),
-            omega / ts * (t - (k * t).sin() / k),
-        )
-    } else {
-        (omega * (t - ts / 2.0), omega)
-    }
-}
 
 #[test]
 fn b3_spin_up_stays_bounded_and_returns_to_the_hub_frame() {

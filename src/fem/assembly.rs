@@ -315,18 +315,6 @@ mod tests {
     use crate::solver::cholesky::SparseCholesky;
     use nalgebra::{DMatrix, SymmetricEigen};
 
-    fn steel() -> IsotropicMaterial {
-        IsotropicMaterial {
-            youngs_modulus: 2.1e11,
-            poisson_ratio: 0.3,
-            density: 7850.0,
-        }
-    }
-
-    fn kinds() -> [ElementKind; 2] {
-        [ElementKind::Hex8, ElementKind::Hex20]
-    }
-
     /// A distorted single element: the unit cube with corners moved (mid-edge nodes of Hex20 on
     /// the straight edges between them).
     fn distorted_element(kind: ElementKind) -> Mesh {
@@ -394,20 +382,20 @@ mod tests {
 
     #[test]
     fn stiffness_has_exactly_six_zero_eigenvalues() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let cube = beam(1.0, 1.0, 1.0, [1, 1, 1], kind).unwrap();
             assert_six_rigid_modes(
-                &stiffness_matrix(&cube, &steel()),
+                &stiffness_matrix(&cube, &IsotropicMaterial::STEEL),
                 &format!("{kind:?} cube"),
             );
             let distorted = distorted_element(kind);
             assert_six_rigid_modes(
-                &stiffness_matrix(&distorted, &steel()),
+                &stiffness_matrix(&distorted, &IsotropicMaterial::STEEL),
                 &format!("{kind:?} distorted"),
             );
             let pair = beam(2.0, 1.0, 0.7, [2, 1, 1], kind).unwrap();
             assert_six_rigid_modes(
-                &stiffness_matrix(&pair, &steel()),
+                &stiffness_matrix(&pair, &IsotropicMaterial::STEEL),
                 &format!("{kind:?} 2×1×1"),
             );
         }
@@ -446,10 +434,10 @@ mod tests {
 
     #[test]
     fn isotropic_block_formula_equals_bt_d_b() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_element(kind);
-            let k = stiffness_matrix(&mesh, &steel()).to_dense();
-            let reference = reference_stiffness(&mesh, &steel());
+            let k = stiffness_matrix(&mesh, &IsotropicMaterial::STEEL).to_dense();
+            let reference = reference_stiffness(&mesh, &IsotropicMaterial::STEEL);
             let scale = reference.amax();
             assert!((k - reference).amax() <= 1e-13 * scale, "{kind:?}");
         }
@@ -458,7 +446,7 @@ mod tests {
     #[test]
     fn masses_sum_to_rho_v_and_hrz_is_positive() {
         let rho = 7850.0;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             for mesh in [
                 beam(1.0, 0.02, 0.03, [5, 2, 3], kind).unwrap(),
                 patch_mesh(kind),
@@ -541,8 +529,8 @@ mod tests {
             }
             u
         };
-        let material = steel();
-        for kind in kinds() {
+        let material = IsotropicMaterial::STEEL;
+        for kind in ElementKind::ALL {
             let mesh = patch_mesh(kind);
             let (lo, hi) = mesh.bounding_box();
             let on_boundary = |p: &[f64; 3]| {

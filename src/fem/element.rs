@@ -227,10 +227,6 @@ pub fn physical_gradients(
 mod tests {
     use super::*;
 
-    fn kinds() -> [ElementKind; 2] {
-        [ElementKind::Hex8, ElementKind::Hex20]
-    }
-
     fn sample_points() -> Vec<[f64; 3]> {
         vec![
             [0.0, 0.0, 0.0],
@@ -243,7 +239,7 @@ mod tests {
 
     #[test]
     fn kronecker_delta_at_nodes() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let n = kind.node_count();
             let mut v = [0.0; MAX_NODES];
             let mut d = [[0.0; 3]; MAX_NODES];
@@ -262,7 +258,7 @@ mod tests {
 
     #[test]
     fn partition_of_unity_and_linear_reproduction() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let n = kind.node_count();
             let nodes = natural_coordinates(kind);
             let mut v = [0.0; MAX_NODES];
@@ -290,7 +286,7 @@ mod tests {
         // Shape functions are polynomials of degree ≤ 3 per variable: the central difference error
         // is h²/6 |f'''| ≤ h² · O(1); with h = 1e-5 and rounding ~1e-16/h the error is ≲ 1e-9.
         let h = 1e-5;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let n = kind.node_count();
             let mut v = [0.0; MAX_NODES];
             let mut d = [[0.0; 3]; MAX_NODES];
@@ -319,7 +315,7 @@ mod tests {
     fn physical_gradients_of_an_affine_element() {
         // x = A ξ + c with a general A: ∇N_a = A⁻ᵀ ∂N_a/∂ξ, det J = det A; check ∇(Σ N_a x_a) = I.
         let a = [[0.6, 0.1, 0.05], [-0.2, 0.4, 0.1], [0.0, 0.15, 0.3]];
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let n = kind.node_count();
             let coords: Vec<[f64; 3]> = natural_coordinates(kind)
                 .iter()

@@ -280,18 +280,6 @@ mod tests {
     use crate::fem::stiffness_matrix;
     use crate::mesh::beam;
 
-    fn steel() -> IsotropicMaterial {
-        IsotropicMaterial {
-            youngs_modulus: 2.1e11,
-            poisson_ratio: 0.3,
-            density: 7850.0,
-        }
-    }
-
-    fn kinds() -> [ElementKind; 2] {
-        [ElementKind::Hex8, ElementKind::Hex20]
-    }
-
     /// A 2×2×1 block of distorted elements (interior corner and top corners moved; Hex20
     /// mid-edge nodes on the straight edges), so that gradients vary within the elements.
     fn distorted_block(kind: ElementKind) -> Mesh {
@@ -357,9 +345,9 @@ mod tests {
 
     #[test]
     fn pattern_is_that_of_the_stiffness_matrix() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);
-            let k = stiffness_matrix(&mesh, &steel());
+            let k = stiffness_matrix(&mesh, &IsotropicMaterial::STEEL);
             let k_g = geometric_stiffness(&mesh, &varied_stress(&mesh));
             assert_eq!(k_g.n, k.n);
             assert_eq!(k_g.row_ptr, k.row_ptr, "{kind:?}");
@@ -372,7 +360,7 @@ mod tests {
         // Each entry is a sum of the same products in the same order whichever triangle it is
         // in (the element matrix is mirrored, not recomputed), so symmetry holds to round-off
         // of the assembly order only: 1e-14 of the largest entry.
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);
             let k_g = geometric_stiffness(&mesh, &varied_stress(&mesh));
             let dense = k_g.to_dense();
@@ -394,7 +382,7 @@ mod tests {
 
     #[test]
     fn zero_stress_gives_zero_matrix() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);
             let k_g = geometric_stiffness(&mesh, &vec![[0.0; 6]; gauss_point_count(&mesh)]);
             assert!(k_g.values.iter().all(|&v| v == 0.0), "{kind:?}");
@@ -411,7 +399,7 @@ mod tests {
         let a = [[0.3, -0.2, 0.5], [0.7, 0.1, -0.4], [-0.6, 0.25, 0.15]];
         let b = [0.01, -0.02, 0.03];
         let sigma = 3.7e6;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             for mesh in [
                 beam(1.3, 0.5, 0.4, [3, 2, 2], kind).unwrap(),
                 distorted_block(kind),
@@ -473,7 +461,7 @@ mod tests {
             [7e-4, -3e-4, -4e-4],
             [-6e-4, 2.5e-4, 1.5e-4],
         ];
-        let material = steel();
+        let material = IsotropicMaterial::STEEL;
         let d = material.elasticity_matrix();
         let strain = [
             a[0][0],
@@ -487,7 +475,7 @@ mod tests {
             .map(|i| (0..6).map(|j| d[i][j] * strain[j]).sum())
             .collect();
         let scale = max_abs(&expected);
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);
             let mut u = vec![0.0; 3 * mesh.node_count()];
             for (i, p) in mesh.nodes().iter().enumerate() {
@@ -511,7 +499,7 @@ mod tests {
 
     #[test]
     fn in_place_and_weighted_sum_agree_with_the_allocating_assembly() {
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);
             let s1 = varied_stress(&mesh);
             let s2: Vec<[f64; 6]> = s1.iter().rev().map(|s| s.map(|v| 0.5 * v + 1e5)).collect();
@@ -520,7 +508,7 @@ mod tests {
             let scale = max_abs(&k1.values).max(max_abs(&k2.values));
 
             // In place into a matrix holding stale values (a clone of K): identical result.
-            let mut out = stiffness_matrix(&mesh, &steel());
+            let mut out = stiffness_matrix(&mesh, &IsotropicMaterial::STEEL);
             geometric_stiffness_into(&mesh, &s1, &mut out);
             assert_eq!(out, k1, "{kind:?}");
 

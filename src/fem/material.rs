@@ -14,6 +14,14 @@ pub struct IsotropicMaterial {
 }
 
 impl IsotropicMaterial {
+    /// Structural steel as in the benchmarks (BENCHMARKS.md, B1): E = 2.1e11 Pa, ν = 0.3,
+    /// ρ = 7850 kg/m³.
+    pub const STEEL: IsotropicMaterial = IsotropicMaterial {
+        youngs_modulus: 2.1e11,
+        poisson_ratio: 0.3,
+        density: 7850.0,
+    };
+
     /// Checks the ranges; the error names the parameter (`material.youngsModulus`, ...), the value
     /// and the reason.
     pub fn validate(&self) -> Result<()> {
@@ -79,22 +87,14 @@ impl IsotropicMaterial {
 mod tests {
     use super::*;
 
-    fn steel() -> IsotropicMaterial {
-        IsotropicMaterial {
-            youngs_modulus: 2.1e11,
-            poisson_ratio: 0.3,
-            density: 7850.0,
-        }
-    }
-
     #[test]
     fn valid_material_passes() {
-        assert!(steel().validate().is_ok());
+        assert!(IsotropicMaterial::STEEL.validate().is_ok());
     }
 
     #[test]
     fn rejections_name_parameter_value_and_reason() {
-        let mut m = steel();
+        let mut m = IsotropicMaterial::STEEL;
         m.youngs_modulus = -1.0;
         let msg = m.validate().unwrap_err().message;
         assert!(
@@ -102,7 +102,7 @@ mod tests {
             "{msg}"
         );
         for nu in [0.5, -1.0, f64::NAN, 0.7] {
-            let mut m = steel();
+            let mut m = IsotropicMaterial::STEEL;
             m.poisson_ratio = nu;
             let msg = m.validate().unwrap_err().message;
             assert!(
@@ -111,7 +111,7 @@ mod tests {
             );
         }
         for rho in [0.0, f64::INFINITY] {
-            let mut m = steel();
+            let mut m = IsotropicMaterial::STEEL;
             m.density = rho;
             let msg = m.validate().unwrap_err().message;
             assert!(msg.starts_with("material.density = "), "{msg}");
@@ -121,7 +121,7 @@ mod tests {
     #[test]
     fn uniaxial_stress_gives_youngs_modulus_and_poisson_contraction() {
         // Invert D for ε under σ = (σ_xx, 0, ...): ε_xx = σ/E, ε_yy = ε_zz = −ν σ/E; shear: G.
-        let m = steel();
+        let m = IsotropicMaterial::STEEL;
         let d = m.elasticity_matrix();
         let e = m.youngs_modulus;
         let nu = m.poisson_ratio;

@@ -521,10 +521,6 @@ mod tests {
     use crate::mesh::beam;
     use crate::solver::cholesky::SparseCholesky;
 
-    fn kinds() -> [ElementKind; 2] {
-        [ElementKind::Hex8, ElementKind::Hex20]
-    }
-
     /// A material of unit modulus: energies, forces and stiffnesses are O(1) on O(1) meshes, so
     /// the finite-difference error estimates below are absolute numbers.
     fn unit_material() -> IsotropicMaterial {
@@ -532,14 +528,6 @@ mod tests {
             youngs_modulus: 1.0,
             poisson_ratio: 0.3,
             density: 1.0,
-        }
-    }
-
-    fn steel() -> IsotropicMaterial {
-        IsotropicMaterial {
-            youngs_modulus: 2.1e11,
-            poisson_ratio: 0.3,
-            density: 7850.0,
         }
     }
 
@@ -617,7 +605,7 @@ mod tests {
         // ~1e-16 · 1e-2 / 1e-5 = 1e-13. Measured: 1.3e-9 (Hex8) and 2.4e-9 (Hex20) · max|f|.
         // The bound 1e-8 · max|f| keeps a margin and is far below any wrong term (≥ 1e-3).
         let h = 1e-5;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let solid = SvkSolid::new(&distorted_patch(kind), &unit_material());
             let x = rotated_deformed(&solid);
             let mut f = vec![0.0; x.len()];
@@ -651,7 +639,7 @@ mod tests {
         // 2.6e-10 (Hex8) and 1.0e-9 (Hex20) · max|K|; the bound 1e-8 · max|K| keeps a margin and
         // is orders below a missing term (e.g. the geometric part, ~|S| ~ 1e-1 |K| here).
         let h = 1e-5;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let solid = SvkSolid::new(&distorted_patch(kind), &unit_material());
             let x = rotated_deformed(&solid);
             let mut k = solid.tangent_pattern();
@@ -700,7 +688,7 @@ mod tests {
         // block (a, b) so the stored matrix must be symmetric to the last bit; a misplaced block
         // would break that. Then: a Cholesky analysed on the linear K (+ αI) must refactor the
         // tangent numerically and solve with it.
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let material = unit_material();
             let mesh = distorted_patch(kind);
             let solid = SvkSolid::new(&mesh, &material);
@@ -748,9 +736,9 @@ mod tests {
         // (measured up to 1.5e-4 N). Bounds: strains below 1e-13 (measured ≤ 1e-14), forces below
         // 1e-13 (λ + 2μ) · 0.1 m² ≈ 3e-3 N, energy below (λ + 2μ) · 1e-28 m³ ≈ 3e-17 J (measured
         // ≤ 8e-19 J). A unit strain would give forces of ~1e10 N.
-        let material = steel();
+        let material = IsotropicMaterial::STEEL;
         let modulus = material.lame_lambda() + 2.0 * material.shear_modulus();
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let solid = SvkSolid::new(&distorted_patch(kind), &material);
             let reference = solid.reference_positions().to_vec();
             let mut f = vec![0.0; reference.len()];
@@ -794,8 +782,8 @@ mod tests {
         // For x = X + u with |∇u| ~ δ, f(X + u) − K u = O(δ²) (the HᵀH of E and F S − S), so
         // |f − K u| / |K u| ≈ δ: with δ ≈ 1e-7 the bound 1e-5 holds with a wide margin and a
         // wrong linear term (relative error O(1)) fails it.
-        let material = steel();
-        for kind in kinds() {
+        let material = IsotropicMaterial::STEEL;
+        for kind in ElementKind::ALL {
             let mesh = distorted_patch(kind);
             let solid = SvkSolid::new(&mesh, &material);
             let linear = stiffness_matrix(&mesh, &material);
@@ -863,7 +851,7 @@ mod tests {
         let trace = e[0][0] + e[1][1] + e[2][2];
         let ee: f64 = e.iter().flatten().map(|v| v * v).sum();
         let density = 0.5 * material.lame_lambda() * trace * trace + material.shear_modulus() * ee;
-        for kind in kinds() {
+        for kind in ElementKind::ALL {
             let solid = SvkSolid::new(&distorted_patch(kind), &material);
             let x: Vec<f64> = solid
                 .reference_positions()
@@ -928,7 +916,7 @@ mod tests {
         use std::time::Instant;
         for divisions in [[20, 2, 2], [40, 4, 4]] {
             let mesh = beam(1.0, 0.02, 0.02, divisions, ElementKind::Hex20).unwrap();
-            let solid = SvkSolid::new(&mesh, &steel());
+            let solid = SvkSolid::new(&mesh, &IsotropicMaterial::STEEL);
             let x: Vec<f64> = solid
                 .reference_positions()
                 .chunks_exact(3)

@@ -20,6 +20,9 @@ pub enum ElementKind {
 }
 
 impl ElementKind {
+    /// Every element kind.
+    pub const ALL: [ElementKind; 2] = [ElementKind::Hex8, ElementKind::Hex20];
+
     /// Nodes per element.
     pub fn node_count(self) -> usize {
         match self {

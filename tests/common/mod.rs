@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: drive a [`Slave`] by variable name.
 #![allow(dead_code)]
 
+pub mod b3;
+
 use flexbody::model::{BodyFile, VariableType};
 use flexbody::slave::Slave;
 
