@@ -1,6 +1,6 @@
 //! B3 (Kane's beam spun up on a hub) through the slave for each model choice: the table of
-//! issue 4. `cargo run --release --example b3_table [-- h]` (default h = 1e-2 s; `full` is also
-//! run at h/4 as the yardstick).
+//! issue 4. `cargo run --release --example b3_table [-- h [filter]]` (default h = 1e-2 s; `full`
+//! is also run at h/4 as the yardstick; `filter` keeps the rows whose label contains it).
 //!
 //! Columns: tip deflection in the hub frame (m) at t = 2, 4, 6, 7, 8, 10, 12, 14 s, the peak and
 //! its time, the largest |deflection| after T_s = 15 s, iterations per step and wall time.
@@ -123,13 +123,26 @@ fn main() {
             ));
         }
     }
+    for frames in [2, 5, 10, 20, 40] {
+        for f_nl in [0, 1] {
+            cases.push((
+                format!(
+                    "reduced strain, {frames} frames, f_nl {}",
+                    if f_nl == 1 { "on" } else { "off" }
+                ),
+                h,
+                vec![("model.nonlinearForces", f_nl), ("model.frames", frames)],
+            ));
+        }
+    }
     cases.push(("full".into(), h, vec![("model.formulation", 2)]));
     cases.push((
         "full (yardstick)".into(),
         h / 4.0,
         vec![("model.formulation", 2)],
     ));
-    for (label, h, settings) in cases {
+    let filter = std::env::args().nth(2).unwrap_or_default();
+    for (label, h, settings) in cases.into_iter().filter(|c| c.0.contains(&filter)) {
         match run(&body, h, &settings) {
             Ok(r) => {
                 let y: Vec<String> = r.samples.iter().map(|v| format!("{v:+.4}")).collect();

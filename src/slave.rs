@@ -5,7 +5,7 @@
 use crate::body::frame::{nearest_rotation, node, set_node};
 use crate::body::interface::{DrivingFrame, InterfaceMotion};
 use crate::body::stiffening::Stiffening;
-use crate::body::{Body, BodyOptions, NodeSet};
+use crate::body::{Body, BodyOptions, NodeSet, Patches};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
@@ -16,6 +16,7 @@ use crate::model::variables::{
     EnumerationSpec, FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT,
 };
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
+use crate::solver::anderson::MAX_DEPTH;
 use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
     StepWorkspace,
@@ -57,6 +58,10 @@ pub struct Parameters {
     pub formulation: i32,
     /// `model.stiffening`: 1 none, 2 inertial, 3 stress.
     pub stiffening: i32,
+    /// `model.frames`: co-moving frames of the reduced-strain body (≥ 1).
+    pub frames: i32,
+    /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
+    pub anderson_depth: i32,
 }
 
 impl Parameters {
@@ -81,12 +86,14 @@ impl Parameters {
             nonlinear_forces: b.model.nonlinear_forces,
             formulation: 1,
             stiffening: 1,
+            frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
+            anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
         }
     }
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
     /// placement, the step size and the iteration settings).
-    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, i32) {
+    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, [i32; 3]) {
         (
             self.material,
             [
@@ -95,7 +102,11 @@ impl Parameters {
                 self.rho_inf.to_bits(),
             ],
             self.nonlinear_forces,
-            self.formulation * 16 + self.stiffening,
+            [
+                self.formulation * 16 + self.stiffening,
+                self.frames,
+                self.anderson_depth,
+            ],
         )
     }
 
@@ -140,7 +151,7 @@ struct Interface {
 
 /// The assembled model for one set of parameters.
 struct Model {
-    key: (IsotropicMaterial, [u64; 3], bool, i32),
+    key: (IsotropicMaterial, [u64; 3], bool, [i32; 3]),
     body: Body,
     free: FreeNodes,
     scheme: GeneralizedAlpha,
@@ -641,6 +652,20 @@ impl Slave {
                 Ok(())
             }
             Target::Fixed {
+                key: FixedKey::AndersonDepth,
+                ..
+            } => {
+                if !(0..=MAX_DEPTH as i32).contains(&value) {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        &format!("must lie in [0, {MAX_DEPTH}]"),
+                    ));
+                }
+                self.parameters.anderson_depth = value;
+                Ok(())
+            }
+            Target::Fixed {
                 key: FixedKey::Formulation,
                 ..
             } => {
@@ -652,6 +677,23 @@ impl Slave {
                 ..
             } => {
                 self.parameters.stiffening = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Frames,
+                ..
+            } => {
+                if value < 1 || value as usize > self.mesh.element_count() {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        &format!(
+                            "must lie in [1, {}] (the number of elements)",
+                            self.mesh.element_count()
+                        ),
+                    ));
+                }
+                self.parameters.frames = value;
                 Ok(())
             }
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
@@ -852,6 +894,14 @@ impl Slave {
         );
         let body = if p.formulation == FORMULATION_FULL {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
+        } else if p.frames > 1 {
+            let lumped = fem::lumped_masses(&self.mesh, p.material.density);
+            body.with_patches(Patches::along_principal_axis(
+                &self.mesh,
+                &p.material,
+                &lumped,
+                p.frames as usize,
+            )?)
         } else {
             body
         };
@@ -869,7 +919,8 @@ impl Slave {
                 )?;
             }
         }
-        let mut workspace = StepWorkspace::new(&body, &free);
+        let mut workspace =
+            StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
         let stiffening = match p.stiffening {
             STIFFENING_INERTIAL => Some(Stiffening::inertial(
                 &self.mesh,
@@ -1420,6 +1471,8 @@ fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
         FixedKey::MaxIterations => Some(p.max_iterations),
         FixedKey::Formulation => Some(p.formulation),
         FixedKey::Stiffening => Some(p.stiffening),
+        FixedKey::Frames => Some(p.frames),
+        FixedKey::AndersonDepth => Some(p.anderson_depth),
         _ => None,
     }
 }

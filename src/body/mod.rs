@@ -4,10 +4,12 @@
 
 pub mod frame;
 pub mod interface;
+pub mod patches;
 pub mod stiffening;
 
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
+pub use patches::Patches;
 
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::sparse::BlockCsr3;
@@ -60,6 +62,10 @@ pub struct Body {
     /// elastic force is the total-Lagrangian St. Venant–Kirchhoff force of `x` instead of
     /// `R K ū` (+ `f_nl`); damping stays the co-rotated one.
     pub full: Option<SvkSolid>,
+    /// Several co-moving frames (`model.frames > 1`, [`patches`]): when present, the elastic
+    /// force is `Σ_p R_p K_p ū_p` (+ each patch's `f_nl`) instead of the body frame's `R K ū`;
+    /// damping and stiffening stay in the body frame.
+    pub patches: Option<Patches>,
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -83,6 +89,7 @@ pub struct ForceScratch {
     damping_force: Vec<f64>,
     mass_times: Vec<f64>,
     stiffening_force: Vec<f64>,
+    patch: Option<patches::PatchScratch>,
 }
 
 impl ForceScratch {
@@ -94,6 +101,12 @@ impl ForceScratch {
     /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N).
     pub fn elastic_force(&self) -> &[f64] {
         &self.elastic_force
+    }
+
+    /// The rotation `R_p` of patch `p` in the last [`Body::internal_force`] call (a body with
+    /// patches only).
+    pub fn patch_rotation(&self, p: usize) -> Matrix3<f64> {
+        self.patch.as_ref().expect("a body with patches").rotations[p]
     }
 }
 
@@ -124,7 +137,20 @@ impl Body {
             frame_weights,
             options,
             full: None,
+            patches: None,
         }
+    }
+
+    /// The same body with several co-moving frames (see [`patches`]).
+    pub fn with_patches(mut self, patches: Patches) -> Body {
+        self.patches = Some(patches);
+        self
+    }
+
+    /// Whether the elastic force is the body frame's `R K ū` (+ `f_nl`): neither the full
+    /// formulation nor patches.
+    pub fn single_frame(&self) -> bool {
+        self.full.is_none() && self.patches.is_none()
     }
 
     /// The same body with the full nonlinear formulation of `material` (its `λ`, `μ`).
@@ -148,6 +174,7 @@ impl Body {
             damping_force: vec![0.0; n3],
             mass_times: vec![0.0; n3],
             stiffening_force: vec![0.0; n3],
+            patch: self.patches.as_ref().map(Patches::scratch),
         }
     }
 
@@ -204,6 +231,10 @@ impl Body {
         let strain_energy = if let Some(full) = &self.full {
             full.internal_force(x, g); // global frame
             f64::NAN
+        } else if let Some(patches) = &self.patches {
+            g.fill(0.0); // global frame
+            let scratch = scratch.patch.as_mut().expect("patch scratch");
+            patches.internal_force(x, self.options.nonlinear_forces, scratch, g)
         } else {
             self.stiffness_blocks.mul_vec(ubar, g);
             0.5 * dot(ubar, g)
@@ -258,7 +289,8 @@ impl Body {
         }
 
         // f_nl: z = H⁻ᵀ m̄, m̄ = Σ ū_i × g_i (elastic g only: f_nl is part of ∂V/∂x).
-        let z = if self.options.nonlinear_forces && self.full.is_none() {
+        let single = self.single_frame();
+        let z = if self.options.nonlinear_forces && single {
             let mut mbar = Vector3::zeros();
             for i in 0..n {
                 mbar += node(ubar, i).cross(&node(g, i));
@@ -271,7 +303,7 @@ impl Body {
         for i in 0..n {
             // Terms in the co-moving frame, rotated to global at the end.
             let mut fi = Vector3::zeros();
-            if self.full.is_none() {
+            if single {
                 fi += node(g, i);
             }
             if damped {
@@ -280,11 +312,11 @@ impl Body {
             if geometric_stiffness.is_some() {
                 fi += node(&scratch.stiffening_force, i);
             }
-            if self.options.nonlinear_forces && self.full.is_none() {
+            if self.options.nonlinear_forces && single {
                 fi -= fw.weights[i] * fw.reference_offsets[i].cross(&z);
             }
             let mut global = r * fi;
-            if self.full.is_some() {
+            if !single {
                 global += node(g, i);
             }
             set_node(f, i, &global);

@@ -116,6 +116,9 @@ pub struct SolverSpec {
     pub tolerance: f64,
     #[serde(default = "SolverSpec::default_max_iterations")]
     pub max_iterations: u32,
+    /// History of Anderson's acceleration of the fixed-point iteration (0: plain; at most 8).
+    #[serde(default = "SolverSpec::default_anderson_depth")]
+    pub anderson_depth: u32,
 }
 
 impl SolverSpec {
@@ -131,6 +134,9 @@ impl SolverSpec {
     fn default_max_iterations() -> u32 {
         25
     }
+    fn default_anderson_depth() -> u32 {
+        crate::solver::generalized_alpha::DEFAULT_ANDERSON_DEPTH as u32
+    }
 }
 
 impl Default for SolverSpec {
@@ -140,17 +146,37 @@ impl Default for SolverSpec {
             rho_inf: Self::default_rho_inf(),
             tolerance: Self::default_tolerance(),
             max_iterations: Self::default_max_iterations(),
+            anderson_depth: Self::default_anderson_depth(),
         }
     }
 }
 
 /// Model switches.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]
 pub struct ModelSpec {
     /// Include the nonlinear internal force `f_nl` (DESIGN.md section 2). Off by default.
     #[serde(default)]
     pub nonlinear_forces: bool,
+    /// Co-moving frames (`model.frames`, see `body::patches`): 1 (the default) is one frame for
+    /// the whole body.
+    #[serde(default = "ModelSpec::default_frames")]
+    pub frames: u32,
+}
+
+impl Default for ModelSpec {
+    fn default() -> Self {
+        ModelSpec {
+            nonlinear_forces: false,
+            frames: ModelSpec::default_frames(),
+        }
+    }
+}
+
+impl ModelSpec {
+    fn default_frames() -> u32 {
+        1
+    }
 }
 
 impl BodyFile {
@@ -205,6 +231,18 @@ impl BodyFile {
                     i.name
                 )));
             }
+        }
+        if self.model.frames < 1 {
+            return Err(Error::new(
+                "body file: model.frames = 0: a body needs at least one co-moving frame",
+            ));
+        }
+        if self.solver.anderson_depth > crate::solver::anderson::MAX_DEPTH as u32 {
+            return Err(Error::new(format!(
+                "body file: solver.andersonDepth = {} exceeds the largest history, {}",
+                self.solver.anderson_depth,
+                crate::solver::anderson::MAX_DEPTH
+            )));
         }
         Ok(())
     }

@@ -1,5 +1,6 @@
 //! Time integration: the constant iteration matrix and its sparse Cholesky factor, generalized-α.
 
+pub mod anderson;
 pub mod cholesky;
 pub mod constraints;
 pub mod generalized_alpha;

@@ -1,0 +1,345 @@
+//! Several co-moving frames: the elements split into patches, each with its own best-fit frame
+//! and its own constant stiffness (`model.frames`, DESIGN.md section 2 generalised).
+//!
+//! One frame per body measures the strain of a part that bends far against a frame that fits
+//! the whole part: where a beam section turns by `θ` relative to the body frame, the linear
+//! strain `ε(ū)` carries a spurious second-order term `~θ²/2` that dwarfs the true axial strain
+//! of a spinning beam (measured on B3 by `examples/b3_strain.rs`). With patches `p`, each of
+//! small angular extent, the strain energy is
+//!
+//! `V = Σ_p ½ ū_pᵀ K_p ū_p`, `ū_p,i = R_pᵀ (x_i − c_p) − X̄_p,i`,
+//!
+//! with `(c_p, R_p)` the best-fit frame of the patch's nodes (weights: the nodes' HRZ-lumped
+//! masses), `K_p` the small-strain stiffness of the patch's elements (`Σ_p K_p = K`) and
+//! `X̄_p,i` the reference offsets from the patch's weighted centroid. Its exact gradient is the
+//! single-frame force applied patch by patch (DESIGN.md section 2, eq. "f_int" and "f_nl"):
+//!
+//! `f_i = Σ_{p ∋ i} R_p (g_p,i − w_i X̄_p,i × z_p)`, `g_p = K_p ū_p`, `z_p = H_p⁻ᵀ Σ_i ū_p,i × g_p,i`.
+//!
+//! As the patches shrink to single elements this is the element-wise co-rotational finite
+//! element method, which converges to the geometrically nonlinear solution for small strains;
+//! one patch is the single-frame body. The mass matrix stays constant and so does the
+//! iteration matrix: the body-frame factorization preconditions the patch forces, whose
+//! Jacobian differs from it by the patches' rotations relative to the body frame.
+
+use super::frame::{add_node, node, set_node, FrameWeights};
+use crate::error::{Error, Result};
+use crate::fem::sparse::BlockCsr3;
+use crate::fem::{self, IsotropicMaterial};
+use crate::mesh::Mesh;
+use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+
+/// One patch: its nodes (global numbers, in local order), its frame weights and `K_p`.
+#[derive(Debug, Clone)]
+pub struct Patch {
+    /// Elements of the patch (mesh numbering).
+    pub elements: Vec<usize>,
+    /// The best-fit frame of the patch's nodes (its `nodes` are the global node numbers; local
+    /// node `k` is `frame_weights.nodes[k]`).
+    pub frame_weights: FrameWeights,
+    /// `K_p` on the patch's local nodes (N/m).
+    stiffness: BlockCsr3,
+}
+
+/// The patches of a body and the length of the largest one (for scratch).
+#[derive(Debug, Clone)]
+pub struct Patches {
+    pub patches: Vec<Patch>,
+    /// For each node, the first patch that contains it (whose frame rotates the node's part of
+    /// the iteration, see `solver::generalized_alpha`).
+    pub node_patch: Vec<usize>,
+    largest: usize,
+}
+
+/// Scratch of [`Patches::internal_force`]: `ū_p` and `g_p` of the largest patch, and the
+/// patches' rotations `R_p` of the last call.
+#[derive(Debug, Clone)]
+pub struct PatchScratch {
+    local_deformation: Vec<f64>,
+    elastic_force: Vec<f64>,
+    pub rotations: Vec<Matrix3<f64>>,
+}
+
+impl Patches {
+    /// Splits the elements of `mesh` into `count` slabs of equal length along the body's
+    /// principal axis of least inertia (its longest direction), by element centroid; empty slabs
+    /// are dropped. `lumped_masses` (kg, positive) weight the patch frames.
+    pub fn along_principal_axis(
+        mesh: &Mesh,
+        material: &IsotropicMaterial,
+        lumped_masses: &[f64],
+        count: usize,
+    ) -> Result<Patches> {
+        if count == 0 {
+            return Err(Error::invalid_value(
+                "model.frames",
+                0.0,
+                "must be at least 1",
+            ));
+        }
+        let nodes = mesh.nodes();
+        let total: f64 = lumped_masses.iter().sum();
+        let centre: Vector3<f64> = nodes
+            .iter()
+            .zip(lumped_masses)
+            .map(|(p, &w)| w * Vector3::from(*p))
+            .sum::<Vector3<f64>>()
+            / total;
+        let mut second_moment = Matrix3::zeros();
+        for (p, &w) in nodes.iter().zip(lumped_masses) {
+            let d = Vector3::from(*p) - centre;
+            second_moment += w * d * d.transpose();
+        }
+        let eigen = SymmetricEigen::new(second_moment);
+        let axis = eigen
+            .eigenvectors
+            .column(eigen.eigenvalues.imax())
+            .into_owned();
+        let centroids: Vec<f64> = (0..mesh.element_count())
+            .map(|e| {
+                let el = mesh.element(e);
+                el.iter()
+                    .map(|&n| Vector3::from(nodes[n]).dot(&axis))
+                    .sum::<f64>()
+                    / el.len() as f64
+            })
+            .collect();
+        let lo = centroids.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = centroids.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let width = (hi - lo).max(f64::MIN_POSITIVE);
+        let mut groups = vec![Vec::new(); count];
+        for (e, &s) in centroids.iter().enumerate() {
+            let slot = (((s - lo) / width * count as f64) as usize).min(count - 1);
+            groups[slot].push(e);
+        }
+        groups.retain(|g| !g.is_empty());
+        Self::from_groups(mesh, material, lumped_masses, groups)
+    }
+
+    /// Patches from groups of elements (each element in exactly one group).
+    pub fn from_groups(
+        mesh: &Mesh,
+        material: &IsotropicMaterial,
+        lumped_masses: &[f64],
+        groups: Vec<Vec<usize>>,
+    ) -> Result<Patches> {
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let mut patches = Vec::with_capacity(groups.len());
+        let mut local = vec![usize::MAX; mesh.node_count()];
+        for elements in groups {
+            // Local numbering of the patch's nodes in order of first appearance.
+            let mut global = Vec::new();
+            let mut connectivity = Vec::new();
+            for &e in &elements {
+                for &n in mesh.element(e) {
+                    if local[n] == usize::MAX {
+                        local[n] = global.len();
+                        global.push(n);
+                    }
+                    connectivity.push(local[n]);
+                }
+            }
+            let sub = Mesh::new(
+                global.iter().map(|&n| mesh.nodes()[n]).collect(),
+                mesh.kind(),
+                connectivity,
+            )?;
+            let stiffness = BlockCsr3::from_csr(&fem::stiffness_matrix(&sub, material));
+            let weights = global.iter().map(|&n| lumped_masses[n]).collect();
+            for &n in &global {
+                local[n] = usize::MAX;
+            }
+            patches.push(Patch {
+                elements,
+                frame_weights: FrameWeights::new(global, weights, &reference),
+                stiffness,
+            });
+        }
+        let largest = patches
+            .iter()
+            .map(|p| p.frame_weights.nodes.len())
+            .max()
+            .unwrap_or(0);
+        let mut node_patch = vec![usize::MAX; mesh.node_count()];
+        for (k, p) in patches.iter().enumerate() {
+            for &n in &p.frame_weights.nodes {
+                if node_patch[n] == usize::MAX {
+                    node_patch[n] = k;
+                }
+            }
+        }
+        Ok(Patches {
+            patches,
+            node_patch,
+            largest,
+        })
+    }
+
+    /// Number of patches.
+    pub fn len(&self) -> usize {
+        self.patches.len()
+    }
+
+    /// Whether there are no patches.
+    pub fn is_empty(&self) -> bool {
+        self.patches.is_empty()
+    }
+
+    /// Scratch for [`Self::internal_force`].
+    pub fn scratch(&self) -> PatchScratch {
+        PatchScratch {
+            local_deformation: vec![0.0; 3 * self.largest],
+            elastic_force: vec![0.0; 3 * self.largest],
+            rotations: vec![Matrix3::identity(); self.patches.len()],
+        }
+    }
+
+    /// Adds the elastic force `f_i = Σ_p R_p (g_p,i − w_i X̄_p,i × z_p)` of positions `x` to `f`
+    /// (global frame, N; `z_p = 0` without `nonlinear_forces`) and returns the strain energy
+    /// `V = Σ_p ½ ū_pᵀ K_p ū_p` (J). No allocation.
+    pub fn internal_force(
+        &self,
+        x: &[f64],
+        nonlinear_forces: bool,
+        scratch: &mut PatchScratch,
+        f: &mut [f64],
+    ) -> f64 {
+        let mut energy = 0.0;
+        for (p, patch) in self.patches.iter().enumerate() {
+            let fw = &patch.frame_weights;
+            let m = 3 * fw.nodes.len();
+            let ubar = &mut scratch.local_deformation[..m];
+            let g = &mut scratch.elastic_force[..m];
+            let frame = fw.best_fit(x);
+            scratch.rotations[p] = frame.rotation;
+            let rt = frame.rotation.transpose();
+            for (k, &n) in fw.nodes.iter().enumerate() {
+                let u = rt * (node(x, n) - frame.origin) - fw.reference_offsets[k];
+                set_node(ubar, k, &u);
+            }
+            patch.stiffness.mul_vec(ubar, g);
+            energy += 0.5 * super::dot(ubar, g);
+            let z = if nonlinear_forces {
+                let mut mbar = Vector3::zeros();
+                for k in 0..fw.nodes.len() {
+                    mbar += node(ubar, k).cross(&node(g, k));
+                }
+                let h_inv = fw
+                    .rotation_sensitivity(&frame, x)
+                    .try_inverse()
+                    .unwrap_or_else(Matrix3::zeros);
+                h_inv.transpose() * mbar
+            } else {
+                Vector3::zeros()
+            };
+            for (k, &n) in fw.nodes.iter().enumerate() {
+                let local = node(g, k) - fw.weights[k] * fw.reference_offsets[k].cross(&z);
+                add_node(f, n, &(frame.rotation * local));
+            }
+        }
+        energy
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{generator, ElementKind};
+
+    fn beam() -> (Mesh, IsotropicMaterial, Vec<f64>) {
+        let mesh = generator::beam(1.0, 0.1, 0.1, [6, 1, 1], ElementKind::Hex8).unwrap();
+        let material = IsotropicMaterial::STEEL;
+        let lumped = fem::lumped_masses(&mesh, material.density);
+        (mesh, material, lumped)
+    }
+
+    #[test]
+    fn slabs_cover_every_element_once_and_their_stiffness_sums_to_k() {
+        let (mesh, material, lumped) = beam();
+        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 3).unwrap();
+        assert_eq!(patches.len(), 3);
+        let mut seen = vec![0; mesh.element_count()];
+        for p in &patches.patches {
+            assert_eq!(p.elements.len(), 2);
+            p.elements.iter().for_each(|&e| seen[e] += 1);
+        }
+        assert!(seen.iter().all(|&s| s == 1));
+        // At x = reference + small u (no rotation), Σ_p K_p u = K u to round-off.
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let u: Vec<f64> = (0..reference.len())
+            .map(|k| 1e-6 * ((k * 7919 % 13) as f64 - 6.0))
+            .collect();
+        let k = fem::stiffness_matrix(&mesh, &material);
+        let mut ku = vec![0.0; u.len()];
+        k.mul_vec(&u, &mut ku);
+        // Remove each patch's rigid part: compare energies instead of forces (frames absorb
+        // the rigid parts of u, which K annihilates too).
+        let x: Vec<f64> = reference.iter().zip(&u).map(|(a, b)| a + b).collect();
+        let mut f = vec![0.0; u.len()];
+        let v = patches.internal_force(&x, true, &mut patches.scratch(), &mut f);
+        let linear = 0.5 * super::super::dot(&u, &ku);
+        assert!(
+            (v - linear).abs() < 1e-4 * linear,
+            "patch energy {v} vs linear {linear}"
+        );
+    }
+
+    #[test]
+    fn force_is_the_gradient_of_the_energy_under_large_rotation() {
+        let (mesh, material, lumped) = beam();
+        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 3).unwrap();
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let q = nalgebra::Rotation3::from_euler_angles(0.4, -0.7, 1.1);
+        // A bent configuration: y += 0.05 x², then rotated and shifted.
+        let x: Vec<f64> = reference
+            .chunks_exact(3)
+            .flat_map(|p| {
+                let bent = Vector3::new(p[0], p[1] + 0.05 * p[0] * p[0], p[2] + 1e-3 * p[0]);
+                let y = q * bent + Vector3::new(0.3, -0.2, 0.1);
+                [y.x, y.y, y.z]
+            })
+            .collect();
+        let mut scratch = patches.scratch();
+        let mut f = vec![0.0; x.len()];
+        patches.internal_force(&x, true, &mut scratch, &mut f);
+        let scale = f.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+        let eps = 1e-7;
+        let mut worst: f64 = 0.0;
+        let mut dummy = vec![0.0; x.len()];
+        for k in (0..x.len()).step_by(5) {
+            let mut xp = x.clone();
+            xp[k] += eps;
+            let vp = patches.internal_force(&xp, true, &mut scratch, &mut dummy);
+            xp[k] -= 2.0 * eps;
+            let vm = patches.internal_force(&xp, true, &mut scratch, &mut dummy);
+            worst = worst.max(((vp - vm) / (2.0 * eps) - f[k]).abs());
+        }
+        assert!(worst < 1e-5 * scale, "worst {worst:e} vs scale {scale:e}");
+        // Exact gradient of a rotation-invariant energy: no net force, no net moment.
+        let (mut force, mut moment) = (Vector3::zeros(), Vector3::zeros());
+        for i in 0..mesh.node_count() {
+            force += node(&f, i);
+            moment += node(&x, i).cross(&node(&f, i));
+        }
+        assert!(force.norm() < 1e-9 * scale && moment.norm() < 1e-9 * scale);
+    }
+
+    #[test]
+    fn rigid_motion_has_no_force() {
+        let (mesh, material, lumped) = beam();
+        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 4).unwrap();
+        let q = nalgebra::Rotation3::from_euler_angles(2.0, 0.3, -1.0);
+        let x: Vec<f64> = mesh
+            .nodes()
+            .iter()
+            .flat_map(|p| {
+                let y = q * Vector3::from(*p) + Vector3::new(5.0, 1.0, 2.0);
+                [y.x, y.y, y.z]
+            })
+            .collect();
+        let mut f = vec![0.0; x.len()];
+        let v = patches.internal_force(&x, true, &mut patches.scratch(), &mut f);
+        assert!(v.abs() < 1e-12);
+        assert!(f.iter().all(|v| v.abs() < 1e-3), "{:?}", &f[..6]);
+    }
+}
