@@ -14,6 +14,8 @@
 //! `O(nnz(L))`. The least squares fit uses the first `fit` entries of `g` only (the positions,
 //! in metres), the mixing applies to all entries (positions and multipliers alike).
 
+use nalgebra::{SMatrix, SVector};
+
 /// The largest history depth (the small least-squares system lives on the stack).
 pub const MAX_DEPTH: usize = 8;
 
@@ -91,36 +93,38 @@ impl Anderson {
         if m == 0 {
             return;
         }
-        // Normal equations (ΔGᵀΔG + εI) γ = ΔGᵀ g over the fitted entries.
+        // Normal equations (ΔGᵀΔG + εI) γ = ΔGᵀ g over the fitted entries, padded to
+        // MAX_DEPTH with the identity (so the unused γ are zero) and solved on the stack.
         let fit = self.fit;
         let column = |j: usize| j * n..j * n + fit;
-        let mut a = [[0.0; MAX_DEPTH]; MAX_DEPTH];
-        let mut b = [0.0; MAX_DEPTH];
+        let mut a = SMatrix::<f64, MAX_DEPTH, MAX_DEPTH>::identity();
+        let mut b = SVector::<f64, MAX_DEPTH>::zeros();
         for i in 0..m {
             let gi = &self.dg[column(i)];
             for j in 0..=i {
-                let gj = &self.dg[column(j)];
-                a[i][j] = dot(gi, gj);
-                a[j][i] = a[i][j];
+                let gij = dot(gi, &self.dg[column(j)]);
+                a[(i, j)] = gij;
+                a[(j, i)] = gij;
             }
             b[i] = dot(gi, &g[..fit]);
         }
-        let trace: f64 = (0..m).map(|i| a[i][i]).sum();
+        let trace: f64 = (0..m).map(|i| a[(i, i)]).sum();
         if !(trace > 0.0 && trace.is_finite()) {
             self.reset_keeping_current();
             return;
         }
-        for (i, row) in a.iter_mut().enumerate().take(m) {
-            row[i] += 1e-12 * trace;
+        for i in 0..m {
+            a[(i, i)] += 1e-12 * trace;
         }
-        let Some(gamma) = cholesky_solve(&mut a, &mut b, m) else {
+        let Some(cholesky) = a.cholesky() else {
             self.reset_keeping_current();
             return;
         };
+        let gamma = cholesky.solve(&b);
         for (j, &gj) in gamma.iter().enumerate().take(m) {
-            let col = j * n;
-            for k in 0..n {
-                g[k] -= gj * (self.dz[col + k] + self.dg[col + k]);
+            let (dz, dg) = (&self.dz[j * n..(j + 1) * n], &self.dg[j * n..(j + 1) * n]);
+            for ((gk, zk), hk) in g.iter_mut().zip(dz).zip(dg) {
+                *gk -= gj * (zk + hk);
             }
         }
     }
@@ -134,48 +138,6 @@ impl Anderson {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// Solves the `m × m` SPD system in place (`b` becomes the solution); `None` if not positive
-/// definite.
-fn cholesky_solve(
-    a: &mut [[f64; MAX_DEPTH]; MAX_DEPTH],
-    b: &mut [f64; MAX_DEPTH],
-    m: usize,
-) -> Option<[f64; MAX_DEPTH]> {
-    for j in 0..m {
-        let mut d = a[j][j];
-        for k in 0..j {
-            d -= a[j][k] * a[j][k];
-        }
-        if !(d > 0.0) {
-            return None;
-        }
-        let d = d.sqrt();
-        a[j][j] = d;
-        for i in j + 1..m {
-            let mut s = a[i][j];
-            for k in 0..j {
-                s -= a[i][k] * a[j][k];
-            }
-            a[i][j] = s / d;
-        }
-    }
-    for i in 0..m {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= a[i][k] * b[k];
-        }
-        b[i] = s / a[i][i];
-    }
-    for i in (0..m).rev() {
-        let mut s = b[i];
-        for k in i + 1..m {
-            s -= a[k][i] * b[k];
-        }
-        b[i] = s / a[i][i];
-    }
-    Some(*b)
 }
 
 #[cfg(test)]
