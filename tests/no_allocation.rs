@@ -10,15 +10,25 @@ use std::alloc::System;
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
+/// One test function: the counting allocator sees every thread of the binary, so the cases run
+/// one after the other.
 #[test]
 fn do_step_does_not_allocate_after_the_first_step() {
-    let mut s = initialized_default(&[
+    steps_do_not_allocate(&[("model.nonlinearForces", 1.0)]);
+    steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.frames", 5.0)]);
+    steps_do_not_allocate(&[("solver.andersonDepth", 0.0)]);
+}
+
+/// Steps of the default body with damping, gravity, a tip load and `settings`.
+fn steps_do_not_allocate(settings: &[(&str, f64)]) {
+    let mut all = vec![
         ("damping.alpha", 1.0),
         ("damping.beta", 1e-4),
         ("gravity[3]", -9.81),
         ("tip.force[2]", -10.0),
-        ("model.nonlinearForces", 1.0),
-    ]);
+    ];
+    all.extend_from_slice(settings);
+    let mut s = initialized_default(&all);
     let names: Vec<u32> = s
         .variables()
         .iter()
@@ -46,6 +56,6 @@ fn do_step_does_not_allocate_after_the_first_step() {
     assert_eq!(
         stats.allocations + stats.reallocations,
         0,
-        "allocations in 20 steps: {stats:?}"
+        "allocations in 20 steps with {settings:?}: {stats:?}"
     );
 }
