@@ -135,6 +135,24 @@ fn main() {
             ));
         }
     }
+    // The same with the plain fixed-point iteration (no Anderson acceleration).
+    for (label, settings) in [
+        ("f_nl off", vec![]),
+        ("f_nl on", vec![("model.nonlinearForces", 1)]),
+        ("stiffening stress", vec![("model.stiffening", 3)]),
+        (
+            "40 frames, f_nl on",
+            vec![("model.nonlinearForces", 1), ("model.frames", 40)],
+        ),
+    ] {
+        let mut settings = settings;
+        settings.push(("solver.andersonDepth", 0));
+        cases.push((
+            format!("reduced strain, {label}, plain iteration"),
+            h,
+            settings,
+        ));
+    }
     cases.push(("full".into(), h, vec![("model.formulation", 2)]));
     cases.push((
         "full (yardstick)".into(),

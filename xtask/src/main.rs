@@ -10,10 +10,13 @@
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
+//! * `bench [--quick]`: the measurement examples in release mode, their tables written to
+//!   `bench/results/<date>.md` (see `bench.rs`).
 //! * `venv`: only the pinned Python environment; prints its interpreter.
 //!
 //! Only `std::process::Command` and the zip crate: no shell, no build scripts of our own.
 
+mod bench;
 mod fmu;
 mod venv;
 
@@ -37,6 +40,8 @@ tasks:
   demo                              simulate the default cantilever with fmpy, print a table,
                                     compare with the Timoshenko deflection, plot to
                                     <target>/demo/cantilever.png
+  bench [--quick]                   run the measurement examples in release mode and write
+                                    their tables to bench/results/<date>.md
   venv                              set up the pinned venv only and print its python";
 
 fn main() -> ExitCode {
@@ -53,6 +58,11 @@ fn main() -> ExitCode {
         "test" => test_task(rest),
         "demo" => demo_task(rest),
         "venv" => venv_task(rest),
+        "bench" => match rest {
+            [] => Workspace::locate().and_then(|w| bench::bench_task(&w, false)),
+            [q] if q == "--quick" => Workspace::locate().and_then(|w| bench::bench_task(&w, true)),
+            _ => Err(format!("unexpected arguments {rest:?}\n{USAGE}")),
+        },
         "-h" | "--help" | "help" => {
             println!("{USAGE}");
             Ok(())
@@ -187,6 +197,13 @@ impl Workspace {
             target_dir,
             cargo,
         })
+    }
+
+    /// A `git` command run in the workspace root.
+    pub fn git(&self) -> Command {
+        let mut command = Command::new("git");
+        command.current_dir(&self.root);
+        command
     }
 
     /// A `cargo` command run in the workspace root.
