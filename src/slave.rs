@@ -17,6 +17,7 @@ use crate::model::variables::{
 };
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
 use crate::solver::anderson::MAX_DEPTH;
+use crate::solver::consistent_acceleration::ConsistentAcceleration;
 use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
     StepWorkspace,
@@ -160,6 +161,8 @@ struct Model {
     /// Geometric stiffening (`model.stiffening` inertial or stress); its `K_G` lives in
     /// `workspace.geometric_stiffness`.
     stiffening: Option<Stiffening>,
+    /// The constant-mass solve for consistent accelerations (initialization, load jumps).
+    mass: ConsistentAcceleration,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -802,6 +805,25 @@ impl Slave {
         let prescribe = |t: f64, state: &mut DynamicState| {
             prescribe_motion(body, interfaces, driving, t - t_c, state)
         };
+        // Held inputs that jumped at this communication point: restart the scheme from the
+        // accelerations consistent with the new loads (second order under changing inputs).
+        if loads_changed(interfaces, &dynamics.loads, inputs)
+            || dynamics.gravity != self.parameters.gravity
+        {
+            let old_gravity = Vector3::from(dynamics.gravity);
+            let old_inputs = &dynamics.loads;
+            let old_loads = |x: &[f64], f: &mut [f64]| {
+                apply_loads(body, interfaces, old_inputs, &old_gravity, x, f)
+            };
+            generalized_alpha::restart_for_load_change(
+                &model.free,
+                &mut model.mass,
+                &old_loads,
+                &loads,
+                &mut dynamics.state,
+                &mut model.workspace,
+            );
+        }
         let problem = generalized_alpha::StepProblem {
             body,
             free: &model.free,
@@ -950,9 +972,10 @@ impl Slave {
         self.model = Some(Model {
             key,
             body,
-            free,
             scheme: GeneralizedAlpha::new(p.rho_inf),
             matrices: Vec::new(),
+            mass: ConsistentAcceleration::new(&free)?,
+            free,
             workspace,
             stiffening,
         });
@@ -1135,6 +1158,7 @@ impl Slave {
             &loads,
             &mut state,
             &mut model.workspace,
+            &mut model.mass,
         )?;
         self.dynamics = Some(Dynamics {
             state,
@@ -1398,6 +1422,14 @@ fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
 
 /// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
 /// torque distributed over its node set; added to `f`.
+/// Whether the force and torque inputs of a force interface differ between `old` and `new`.
+fn loads_changed(interfaces: &[Interface], old: &[Inputs], new: &[Inputs]) -> bool {
+    interfaces
+        .iter()
+        .zip(old.iter().zip(new))
+        .any(|(i, (a, b))| i.kind == InterfaceKind::Force && a[..6] != b[..6])
+}
+
 fn apply_loads(
     body: &Body,
     interfaces: &[Interface],

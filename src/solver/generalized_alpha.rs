@@ -20,6 +20,7 @@
 
 use super::anderson::Anderson;
 use super::cholesky::{SolveWorkspace, SparseCholesky};
+use super::consistent_acceleration::ConsistentAcceleration;
 use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
 use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
@@ -369,6 +370,7 @@ pub struct StepWorkspace {
     anderson: Anderson,
     iterate: Vec<f64>,
     update: Vec<f64>,
+    multiplier_change: Vec<f64>,
     /// The geometric stiffness `K_G` of the current prestress (stiffening), if any: set by the
     /// owner before a step, constant during it.
     pub geometric_stiffness: Option<SymmetricCsr>,
@@ -387,6 +389,7 @@ impl StepWorkspace {
             anderson: Anderson::new(depth, nz, free.dof_count()),
             iterate: vec![0.0; nz],
             update: vec![0.0; nz],
+            multiplier_change: vec![0.0; free.multiplier_count()],
             internal: vec![0.0; n3],
             external: vec![0.0; n3],
             inertia: vec![0.0; n3],
@@ -667,76 +670,70 @@ fn iterate(
 
 /// Consistent initial acceleration on the free DOFs and multipliers:
 /// `M_FF ẍ_F + Cᵀλ = (f_ext − f(x, ẋ) − M_FC ẍ_C)_F`, `C ẍ = 0`, with the clamped nodes'
-/// accelerations `ẍ_C` as given in `state`. One factorization of `Ms_FF` (at initialization
-/// only); with `s_p` the weights of point constraint `p` on the free nodes, `C M⁻¹ Cᵀ` is
-/// `B ⊗ I3` with the scalar `B_pq = s_pᵀ Ms⁻¹ s_q`.
+/// accelerations `ẍ_C` as given in `state` ([`ConsistentAcceleration`]).
 pub fn initial_acceleration(
     body: &Body,
     free: &FreeNodes,
     loads: &dyn Fn(&[f64], &mut [f64]),
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
+    mass: &mut ConsistentAcceleration,
 ) -> Result<()> {
     for &i in &free.nodes {
         state.acceleration[3 * i..3 * i + 3].fill(0.0);
     }
     state.multipliers.fill(0.0);
     residual(body, free, state, loads, ws);
-    let factor = SparseCholesky::new(&free.scalar_mass)?;
-    let mut solve_ws = factor.solve_scratch();
-    let nf = free.nodes.len();
-    let mut rhs = vec![0.0; nf];
-    for d in 0..3 {
-        for (k, &i) in free.nodes.iter().enumerate() {
-            rhs[k] = -ws.internal[3 * i + d];
-        }
-        factor.solve_in_place(&mut rhs, &mut solve_ws);
-        for (k, &i) in free.nodes.iter().enumerate() {
-            state.acceleration[3 * i + d] = rhs[k];
-        }
-    }
-    let m = free.constraints.len();
-    if m > 0 {
-        // Ms⁻¹ s_p for every constraint, and B.
-        let mut inv_s = vec![vec![0.0; nf]; m];
-        for (p, c) in free.constraints.iter().enumerate() {
-            for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
-                inv_s[p][row / 3] = w;
-            }
-            factor.solve_in_place(&mut inv_s[p], &mut solve_ws);
-        }
-        let b = nalgebra::DMatrix::from_fn(m, m, |p, q| {
-            free.constraints[p]
-                .free_rows
-                .iter()
-                .zip(&free.constraints[p].weights)
-                .map(|(&row, &w)| w * inv_s[q][row / 3])
-                .sum::<f64>()
-        });
-        let b_inv = b
-            .try_inverse()
-            .ok_or_else(|| Error::new("the pin constraints are redundant"))?;
-        for d in 0..3 {
-            // λ_d = B⁻¹ (C ẍ_u)_d, ẍ_d ← ẍ_d − Σ_p Ms⁻¹ s_p λ_pd.
-            let cx = nalgebra::DVector::from_fn(m, |p, _| {
-                let c = &free.constraints[p];
-                c.nodes
-                    .iter()
-                    .zip(&c.weights)
-                    .map(|(&n, &w)| w * state.acceleration[3 * n + d])
-                    .sum::<f64>()
-            });
-            let lambda = &b_inv * cx;
-            for p in 0..m {
-                state.multipliers[3 * p + d] = lambda[p];
-                for (k, &i) in free.nodes.iter().enumerate() {
-                    state.acceleration[3 * i + d] -= inv_s[p][k] * lambda[p];
-                }
-            }
-        }
-    }
+    ws.internal.iter_mut().for_each(|r| *r = -*r);
+    mass.solve(
+        free,
+        &ws.internal,
+        &mut state.acceleration,
+        &mut state.multipliers,
+    );
     state
         .pseudo_acceleration
         .copy_from_slice(&state.acceleration);
     Ok(())
+}
+
+/// Restarts the scheme after the external loads jumped at `state.time` (held inputs change at a
+/// communication point): the accelerations and the pseudo-accelerations of the free nodes gain
+/// `Δẍ` and the multipliers `Δλ` from `M_FF Δẍ_F + CᵀΔλ = Δf_ext`, `C Δẍ = 0`, with
+/// `Δf_ext = new_loads(x) − old_loads(x)`. Without it the scheme starts the step from the old
+/// loads' acceleration (the left limit) and a jump costs an error of order `h`, which made the
+/// scheme first order under inputs that change (`tests/convergence_order.rs`). For a linear
+/// system this is exact superposition: the jump's response is a fresh start from rest with
+/// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation.
+pub fn restart_for_load_change(
+    free: &FreeNodes,
+    mass: &mut ConsistentAcceleration,
+    old_loads: &dyn Fn(&[f64], &mut [f64]),
+    new_loads: &dyn Fn(&[f64], &mut [f64]),
+    state: &mut DynamicState,
+    ws: &mut StepWorkspace,
+) {
+    ws.external.fill(0.0);
+    new_loads(&state.position, &mut ws.external);
+    ws.inertia.fill(0.0);
+    old_loads(&state.position, &mut ws.inertia);
+    for (new, old) in ws.external.iter_mut().zip(&ws.inertia) {
+        *new -= old;
+    }
+    ws.inertia.fill(0.0);
+    mass.solve(
+        free,
+        &ws.external,
+        &mut ws.inertia,
+        &mut ws.multiplier_change,
+    );
+    for &i in &free.nodes {
+        for d in 3 * i..3 * i + 3 {
+            state.acceleration[d] += ws.inertia[d];
+            state.pseudo_acceleration[d] += ws.inertia[d];
+        }
+    }
+    for (l, dl) in state.multipliers.iter_mut().zip(&ws.multiplier_change) {
+        *l += dl;
+    }
 }
