@@ -862,15 +862,22 @@ impl Slave {
             .variables
             .get(VariableType::Real, vr)
             .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
-        let (name, target, causality) = (v.name.clone(), v.target, v.causality);
+        let (target, causality) = (v.target, v.causality);
+        // The name only for messages (no allocation on the way to a value).
+        let name = |s: &Slave| {
+            s.variables
+                .get(VariableType::Real, vr)
+                .map_or(String::new(), |v| v.name.clone())
+        };
         if causality != crate::model::Causality::Output {
             return Err(Error::new(format!(
-                "{name} (value reference {vr}) is not an output: only outputs have derivatives to get"
+                "{} (value reference {vr}) is not an output: only outputs have derivatives to get",
+                name(self)
             )));
         }
         if !(1..=MAX_OUTPUT_DERIVATIVE_ORDER).contains(&order) {
             return Err(Error::invalid_value(
-                &format!("the order of the derivative of {name}"),
+                &format!("the order of the derivative of {}", name(self)),
                 order,
                 &format!("must be 1 or {MAX_OUTPUT_DERIVATIVE_ORDER} (maxOutputDerivativeOrder)"),
             ));
@@ -933,10 +940,12 @@ impl Slave {
         match value {
             Some(x) if x.is_finite() => Ok(x),
             Some(x) => Err(Error::new(format!(
-                "the derivative of order {order} of {name} evaluated to {x}: the state is not finite"
+                "the derivative of order {order} of {} evaluated to {x}: the state is not finite",
+                name(self)
             ))),
             None => Err(Error::new(format!(
-                "{name} (value reference {vr}) has no derivative of order {order} (available: interface position and rotation up to order 2, velocity and angularVelocity order 1; body.position up to order 2, body.velocity, body.linearMomentum and body.rotation order 1)"
+                "{} (value reference {vr}) has no derivative of order {order} (available: interface position and rotation up to order 2, velocity and angularVelocity order 1; body.position up to order 2, body.velocity, body.linearMomentum and body.rotation order 1)",
+                name(self)
             ))),
         }
     }

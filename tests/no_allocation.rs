@@ -38,6 +38,12 @@ fn do_step_does_not_allocate_after_the_first_step() {
         s.do_step(t, big).unwrap();
         t += big;
         s.set_real(force_x, k as f64).unwrap();
+        // Force inputs extrapolated over the step (fmi2SetRealInputDerivatives).
+        s.set_real_input_derivatives(&[force_x, force_x], &[1, 2], &[k as f64, -2.0 * k as f64])
+            .unwrap();
+        for &vr in &[force_x] {
+            s.get_real_output_derivative(vr + 6, 1).unwrap(); // tip.position[1]
+        }
         for &vr in &names {
             s.get_real(vr).unwrap();
         }
