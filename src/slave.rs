@@ -25,9 +25,16 @@ use crate::solver::generalized_alpha::{
 use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 
+mod state_bytes;
+pub use state_bytes::PAYLOAD_FORMAT as STATE_PAYLOAD_FORMAT;
+
 /// The input values of one interface, indexed by value-reference slot
 /// ([`InterfaceQuantity::slot`]).
 type Inputs = [f64; 30];
+
+/// The first and second time derivatives of one interface's inputs (`fmi2SetRealInputDerivatives`;
+/// only the force and torque slots of force interfaces are ever non-zero).
+type InputDerivatives = [Inputs; 2];
 
 /// `model.formulation` item of the full nonlinear reference.
 const FORMULATION_FULL: i32 = 2;
@@ -35,8 +42,30 @@ const FORMULATION_FULL: i32 = 2;
 const STIFFENING_INERTIAL: i32 = 2;
 const STIFFENING_STRESS: i32 = 3;
 
-/// Most factorizations kept (one per internal step size in use).
-const MATRIX_CACHE_SIZE: usize = 4;
+/// Most factorizations kept, one per internal step size in use, least recently used evicted.
+///
+/// Memory: each entry holds the sparse Cholesky factor of the free DOFs' iteration matrix plus
+/// its solve workspace (and, with pins or hinges, the small dense Schur complement). For the
+/// default body (621 nodes, 1 800 free DOF) the factor holds 223 083 values (1.8 MB, about 3 MB
+/// with its indices); the cache is bounded by four of them whatever sequence of communication
+/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound).
+/// Four covers a steady step size, a last partial step and the three step sizes of the retries
+/// of a failed internal step ([`MAX_STEP_HALVINGS`]); a fifth size evicts the least recently used
+/// one, which is factorised again when it comes back.
+pub const MATRIX_CACHE_SIZE: usize = 4;
+
+/// How often an internal step that did not converge is retried with halved internal steps
+/// (2, 4, ..., 2^MAX_STEP_HALVINGS steps in its place) before the communication step is
+/// discarded. Smaller steps help the fixed-point iteration: the mass term `M/(βh²)` of the
+/// constant iteration matrix grows like `1/h²` and the neglected nonlinear terms do not.
+pub const MAX_STEP_HALVINGS: u32 = 3;
+
+/// Highest order of `fmi2SetRealInputDerivatives` (force inputs are extrapolated by their Taylor
+/// polynomial of this degree).
+pub const MAX_INPUT_DERIVATIVE_ORDER: i32 = 2;
+
+/// `maxOutputDerivativeOrder`: see [`Slave::get_real_output_derivative`].
+pub const MAX_OUTPUT_DERIVATIVE_ORDER: i32 = 2;
 
 /// The parameters of DESIGN.md section 4 (SI units).
 #[derive(Debug, Clone, PartialEq)]
@@ -175,13 +204,18 @@ struct Dynamics {
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
-/// accelerations, inputs, parameters). Restoring it reproduces later steps bit for bit.
+/// accelerations, inputs and their derivatives, parameters) and the step counters. Restoring it
+/// reproduces later steps bit for bit. [`SlaveState::to_bytes`] / [`Slave::state_from_bytes`]
+/// give it a portable byte form (module `state_bytes`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SlaveState {
     parameters: Parameters,
     inputs: Vec<Inputs>,
+    input_derivatives: Vec<InputDerivatives>,
     start_time: f64,
     dynamics: Option<Dynamics>,
+    /// Internal steps, fixed-point iterations, retried internal steps.
+    counters: [u64; 3],
 }
 
 /// Outputs computed once per state, on the first read.
@@ -189,6 +223,8 @@ pub struct SlaveState {
 struct Outputs {
     valid: bool,
     body: [f64; 26],
+    /// Acceleration of the centre of mass (for output derivatives).
+    body_acceleration: [f64; 3],
     /// Per interface: force[3], torque[3], then motion (position, rotation, velocity, angular
     /// velocity, acceleration, angular acceleration) in value-reference slot order.
     interfaces: Vec<[f64; 30]>,
@@ -217,6 +253,9 @@ pub struct Slave {
     parameters: Parameters,
     inputs: Vec<Inputs>,
     default_inputs: Vec<Inputs>,
+    /// Input derivatives (`fmi2SetRealInputDerivatives`), with respect to the communication
+    /// point: over a step the force inputs are `u(t) = u + u'·τ + u''·τ²/2`, `τ = t − t_c`.
+    input_derivatives: Vec<InputDerivatives>,
     /// The driving frames of motion interfaces during the current step.
     driving: Vec<DrivingFrame>,
     start_time: f64,
@@ -224,9 +263,13 @@ pub struct Slave {
     dynamics: Option<Dynamics>,
     /// Backup of the dynamics at the start of a communication step (rollback on failure).
     backup: Option<DynamicState>,
+    /// Backup at the start of an internal step being retried with smaller steps.
+    retry_backup: Option<DynamicState>,
     outputs: Outputs,
     /// Internal steps and fixed-point iterations since initialization.
     statistics: (u64, u64),
+    /// Internal steps that did not converge and were retried with halved steps.
+    retries: u64,
     /// Messages for the logger, drained by the FMI layer after each call.
     events: Vec<LogEvent>,
 }
@@ -336,16 +379,19 @@ impl Slave {
             defaults,
             inputs: default_inputs.clone(),
             default_inputs,
+            input_derivatives: vec![[[0.0; 30]; 2]; n_interfaces],
             driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
             dynamics: None,
             backup: None,
+            retry_backup: None,
             outputs: Outputs {
                 interfaces: vec![[0.0; 30]; n_interfaces],
                 ..Outputs::default()
             },
             statistics: (0, 0),
+            retries: 0,
             events: Vec::new(),
         })
     }
@@ -451,14 +497,33 @@ impl Slave {
         self.statistics
     }
 
+    /// Step sizes with a factorization in the cache (at most [`MATRIX_CACHE_SIZE`]), most
+    /// recently used last.
+    pub fn cached_step_sizes(&self) -> Vec<f64> {
+        self.model.as_ref().map_or_else(Vec::new, |m| {
+            m.matrices.iter().map(|x| x.step_size).collect()
+        })
+    }
+
+    /// Internal steps that did not converge and were retried with halved steps (each retry
+    /// counts once per halving).
+    pub fn step_retries(&self) -> u64 {
+        self.retries
+    }
+
     /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values). The
     /// assembled matrices are kept for reuse if the parameters come back the same.
     pub fn reset(&mut self) {
         self.parameters = self.defaults.clone();
         self.inputs.clone_from(&self.default_inputs);
+        for d in &mut self.input_derivatives {
+            *d = [[0.0; 30]; 2];
+        }
         self.start_time = 0.0;
         self.dynamics = None;
         self.backup = None;
+        self.statistics = (0, 0);
+        self.retries = 0;
         self.outputs.valid = false;
     }
 
@@ -467,19 +532,26 @@ impl Slave {
         SlaveState {
             parameters: self.parameters.clone(),
             inputs: self.inputs.clone(),
+            input_derivatives: self.input_derivatives.clone(),
             start_time: self.start_time,
             dynamics: self.dynamics.clone(),
+            counters: [self.statistics.0, self.statistics.1, self.retries],
         }
     }
 
     /// `fmi2SetFMUstate`.
     pub fn set_state(&mut self, state: &SlaveState) -> Result<()> {
-        if state.inputs.len() != self.inputs.len() {
+        if state.inputs.len() != self.inputs.len()
+            || state.input_derivatives.len() != self.inputs.len()
+        {
             return Err(Error::new("the FMU state belongs to another body"));
         }
         self.parameters = state.parameters.clone();
         self.inputs.clone_from(&state.inputs);
+        self.input_derivatives.clone_from(&state.input_derivatives);
         self.start_time = state.start_time;
+        self.statistics = (state.counters[0], state.counters[1]);
+        self.retries = state.counters[2];
         if state.dynamics.is_some() {
             self.ensure_model()?;
         }
@@ -726,6 +798,203 @@ impl Slave {
         }
     }
 
+    /// Checks a value for a Real variable as [`Slave::set_real`] would, without setting it (so
+    /// that an `fmi2SetReal` call with one bad value sets none). Allocation-free unless it fails.
+    pub fn check_real(&self, vr: u32, value: f64) -> Result<()> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        match v.target {
+            Target::Fixed { key, .. } => Parameters::check_real(&v.name, key, value),
+            Target::Interface { .. } if !value.is_finite() => {
+                Err(Error::invalid_value(&v.name, value, "not a finite number"))
+            }
+            Target::Interface { .. } => Ok(()),
+        }
+    }
+
+    /// `fmi2SetRealInputDerivatives`: `values[k]` is the `orders[k]`-th time derivative (1 or 2)
+    /// of the force or torque input `vrs[k]` of a force interface, with respect to the
+    /// communication point. Over the following `fmi2DoStep` the input is extrapolated as
+    /// `u(t) = u + u'·(t − t_c) + u''·(t − t_c)²/2` and applied at the end of every internal
+    /// step (see [`Slave::do_step`]); a derivative stays in force until it is set again (0
+    /// switches it off) and `fmi2Reset` clears it. Motion interfaces already extrapolate their
+    /// pose with their velocity inputs: derivatives of their inputs are refused. All or nothing:
+    /// one rejected entry sets none. Allocation-free unless it fails.
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Result<()> {
+        for ((&vr, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            self.input_derivative_slot(vr, order, value)?;
+        }
+        for ((&vr, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            let (index, order, slot) = self.input_derivative_slot(vr, order, value)?;
+            self.input_derivatives[index][order][slot] = value;
+        }
+        Ok(())
+    }
+
+    /// Where derivative `order` of input `vr` is kept (interface, order − 1, slot), after
+    /// checking the request.
+    fn input_derivative_slot(
+        &self,
+        vr: u32,
+        order: i32,
+        value: f64,
+    ) -> Result<(usize, usize, usize)> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        if v.causality != crate::model::Causality::Input {
+            return Err(Error::new(format!(
+                "{} (value reference {vr}) is not an input: only inputs have derivatives to set",
+                v.name
+            )));
+        }
+        if !(1..=MAX_INPUT_DERIVATIVE_ORDER).contains(&order) {
+            return Err(Error::invalid_value(
+                &format!("the order of the derivative of {}", v.name),
+                order,
+                &format!("must be 1 or {MAX_INPUT_DERIVATIVE_ORDER}"),
+            ));
+        }
+        if !value.is_finite() {
+            return Err(Error::invalid_value(
+                &format!("derivative of order {order} of {}", v.name),
+                value,
+                "not a finite number",
+            ));
+        }
+        match v.target {
+            Target::Interface {
+                index,
+                quantity: q @ (InterfaceQuantity::Force | InterfaceQuantity::Torque),
+                component,
+            } if self.interfaces[index].kind == InterfaceKind::Force => {
+                Ok((index, order as usize - 1, q.slot() as usize + component))
+            }
+            _ => Err(Error::new(format!(
+                "{} (value reference {vr}): input derivatives are supported for the force and torque inputs of force interfaces; a motion interface's pose is extrapolated with its velocity inputs",
+                v.name
+            ))),
+        }
+    }
+
+    /// `fmi2GetRealOutputDerivatives`: the `order`-th time derivative (1 or 2) of an output at the
+    /// current time. Available:
+    ///
+    /// | output | order 1 | order 2 |
+    /// | --- | --- | --- |
+    /// | `<i>.position` (force interface) | `<i>.velocity` | `<i>.acceleration` |
+    /// | `<i>.rotation` | `[ω]× R` | `([α]× + [ω]×[ω]×) R` |
+    /// | `<i>.velocity`, `<i>.angularVelocity` | `<i>.acceleration`, `<i>.angularAcceleration` | — |
+    /// | `body.position` | `body.velocity` | centre-of-mass acceleration |
+    /// | `body.velocity` | centre-of-mass acceleration | — |
+    /// | `body.linearMomentum` | total mass × centre-of-mass acceleration | — |
+    /// | `body.rotation` | `[ω]× R` (`ω` = `body.angularVelocity`) | — |
+    ///
+    /// An interface's rates are those of the least-squares rigid motion of its node set (the
+    /// velocity and acceleration outputs): the exact time derivatives of its pose for a rigid
+    /// motion of the set, and within the set's deformation rate otherwise. Other outputs
+    /// (reactions, energies, momenta' rates other than the above) have no derivative: an error.
+    pub fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        let (target, causality) = (v.target, v.causality);
+        // The name only for messages (no allocation on the way to a value).
+        let name = |s: &Slave| {
+            s.variables
+                .get(VariableType::Real, vr)
+                .map_or(String::new(), |v| v.name.clone())
+        };
+        if causality != crate::model::Causality::Output {
+            return Err(Error::new(format!(
+                "{} (value reference {vr}) is not an output: only outputs have derivatives to get",
+                name(self)
+            )));
+        }
+        if !(1..=MAX_OUTPUT_DERIVATIVE_ORDER).contains(&order) {
+            return Err(Error::invalid_value(
+                &format!("the order of the derivative of {}", name(self)),
+                order,
+                &format!("must be 1 or {MAX_OUTPUT_DERIVATIVE_ORDER} (maxOutputDerivativeOrder)"),
+            ));
+        }
+        self.ensure_outputs()?;
+        let rotation_rate = |r: &[f64], w: &[f64], a: Option<&[f64]>, c: usize| {
+            let r = Matrix3::from_row_slice(r);
+            let w = Vector3::from_column_slice(w).cross_matrix();
+            let rate = match a {
+                None => w * r,
+                Some(a) => (Vector3::from_column_slice(a).cross_matrix() + w * w) * r,
+            };
+            rate[(c / 3, c % 3)]
+        };
+        use InterfaceQuantity as Q;
+        let slot = |q: Q| q.slot() as usize;
+        let value = match target {
+            Target::Interface {
+                index,
+                quantity,
+                component: c,
+            } if self.interfaces[index].kind == InterfaceKind::Force => {
+                let out = &self.outputs.interfaces[index];
+                let three = |q: Q| &out[slot(q)..slot(q) + 3];
+                match (quantity, order) {
+                    (Q::Position, 1) => Some(out[slot(Q::Velocity) + c]),
+                    (Q::Position, 2) | (Q::Velocity, 1) => Some(out[slot(Q::Acceleration) + c]),
+                    (Q::AngularVelocity, 1) => Some(out[slot(Q::AngularAcceleration) + c]),
+                    (Q::Rotation, 1) => Some(rotation_rate(
+                        &out[slot(Q::Rotation)..slot(Q::Rotation) + 9],
+                        three(Q::AngularVelocity),
+                        None,
+                        c,
+                    )),
+                    (Q::Rotation, 2) => Some(rotation_rate(
+                        &out[slot(Q::Rotation)..slot(Q::Rotation) + 9],
+                        three(Q::AngularVelocity),
+                        Some(three(Q::AngularAcceleration)),
+                        c,
+                    )),
+                    _ => None,
+                }
+            }
+            Target::Fixed { key, component: c } => {
+                let body = &self.outputs.body;
+                let acom = &self.outputs.body_acceleration;
+                let mass = self.model.as_ref().map_or(0.0, |m| m.body.total_mass);
+                match (key, order) {
+                    (FixedKey::BodyPosition, 1) => Some(body[12 + c]),
+                    (FixedKey::BodyPosition, 2) | (FixedKey::BodyVelocity, 1) => Some(acom[c]),
+                    (FixedKey::BodyLinearMomentum, 1) => Some(mass * acom[c]),
+                    (FixedKey::BodyRotation, 1) => {
+                        Some(rotation_rate(&body[3..12], &body[15..18], None, c))
+                    }
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
+        match value {
+            Some(x) if x.is_finite() => Ok(x),
+            Some(x) => Err(Error::new(format!(
+                "the derivative of order {order} of {} evaluated to {x}: the state is not finite",
+                name(self)
+            ))),
+            None => Err(Error::new(format!(
+                "{} (value reference {vr}) has no derivative of order {order} (available: interface position and rotation up to order 2, velocity and angularVelocity order 1; body.position up to order 2, body.velocity, body.linearMomentum and body.rotation order 1)",
+                name(self)
+            ))),
+        }
+    }
+
     /// `fmi2DoStep`: advances from `current_communication_point` (must match the internal time
     /// within a relative 1e-5 of the step) by `communication_step_size` > 0, in equal internal
     /// steps no longer than `solver.stepSize`. On error the state is unchanged; a step that does
@@ -768,12 +1037,10 @@ impl Slave {
             ));
         }
         let h = big_h / substeps;
+        let n = substeps as usize;
         self.update_driving_frames()?;
-        let index = self.matrix_index(h)?;
-        let settings = IterationSettings {
-            absolute_tolerance: self.parameters.tolerance * self.size,
-            max_iterations: self.parameters.max_iterations.max(1) as usize,
-        };
+        // Factorise (on a cache miss) before anything changes: an error here leaves the state.
+        self.matrix_index(h)?;
         let model = self.model.as_mut().expect("matrix_index built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
         if let (Some(stiffening), Some(k_g)) = (
@@ -794,36 +1061,147 @@ impl Slave {
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
         dynamics.state.time = current_communication_point;
+        // Held inputs that jump at a communication point are not restarted from consistent
+        // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
+        // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
+        // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
+        // H = 2e-4 s). Input derivatives give continuous loads instead.
+        let mut result = Ok(());
+        for i in 0..n {
+            result = self.internal_step(current_communication_point, big_h, i, n, h);
+            if result.is_err() {
+                break;
+            }
+        }
+        let dynamics = self.dynamics.as_mut().unwrap();
+        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
+            result = Err(Error::discard("the step produced non-finite positions"));
+        }
+        match result {
+            Ok(()) => {
+                dynamics.state.time = current_communication_point + big_h;
+                // The end state's accelerations belong to the inputs extrapolated to t_c + H.
+                dynamics.loads.clone_from(&self.inputs);
+                for (load, d) in dynamics.loads.iter_mut().zip(&self.input_derivatives) {
+                    extrapolate(load, d, big_h);
+                }
+                dynamics.gravity = self.parameters.gravity;
+                self.outputs.valid = false;
+                Ok(())
+            }
+            Err(e) => {
+                dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                self.outputs.valid = false;
+                let kind = e.kind;
+                let message = format!(
+                    "doStep from t = {current_communication_point} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {current_communication_point}{}",
+                    e.message,
+                    if kind == ErrorKind::Discard {
+                        "; retry with a smaller communication step (fmi2SetFMUstate to a saved state, or fmi2Reset)"
+                    } else {
+                        ""
+                    }
+                );
+                Err(Error { kind, message })
+            }
+        }
+    }
+
+    /// Internal step `i` of `n` (of length `h`) of the communication step from `t_c` by `big_h`.
+    /// If it does not converge it is redone as 2, 4, ... 2^[`MAX_STEP_HALVINGS`] steps (each
+    /// halving logged under `logEvents`); the error of the last attempt is returned if none
+    /// converges, with the state back at the start of this internal step. No allocation unless
+    /// a step fails.
+    fn internal_step(&mut self, t_c: f64, big_h: f64, i: usize, n: usize, h: f64) -> Result<()> {
+        let tau0 = i as f64 * h;
+        let mut depth = 0;
+        loop {
+            let m = 1usize << depth;
+            let hs = h / m as f64;
+            let index = self.matrix_index(hs)?;
+            if depth > 0 {
+                let state = &self.dynamics.as_ref().unwrap().state;
+                self.retry_backup
+                    .get_or_insert_with(|| state.clone())
+                    .copy_from(state);
+            }
+            let result = self.advance(index, t_c, big_h, tau0, hs, m, i + 1 == n);
+            let e = match result {
+                Ok(()) => return Ok(()),
+                Err(e) => e,
+            };
+            if depth > 0 {
+                let state = &mut self.dynamics.as_mut().unwrap().state;
+                state.copy_from(self.retry_backup.as_ref().unwrap());
+            }
+            if e.kind != ErrorKind::Discard {
+                return Err(e);
+            }
+            if depth == MAX_STEP_HALVINGS {
+                return Err(Error::discard(format!(
+                    "the internal step from t = {} (h = {h:e}) did not converge, nor when retried with {m} steps of h/{m} = {hs:e}: {}",
+                    t_c + tau0,
+                    e.message
+                )));
+            }
+            depth += 1;
+            self.retries += 1;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "internal step from t = {} (h = {hs:e}) did not converge ({}); retrying it as {} steps of {:e} s",
+                    t_c + tau0,
+                    e.message,
+                    1usize << depth,
+                    h / (1usize << depth) as f64
+                ),
+            });
+        }
+    }
+
+    /// `m` internal steps of `hs` with iteration matrix `index`, from `tau0` after the
+    /// communication point `t_c`. Force inputs are taken at each internal step's end,
+    /// `u(t_c + τ) = u + u'·τ + u''·τ²/2` (the generalized-α scheme here satisfies the equations
+    /// of motion at the end of each internal step, so this is where the load enters); the last
+    /// internal step of the communication step uses `τ = big_h` exactly.
+    #[allow(clippy::too_many_arguments)]
+    fn advance(
+        &mut self,
+        index: usize,
+        t_c: f64,
+        big_h: f64,
+        tau0: f64,
+        hs: f64,
+        m: usize,
+        last_of_step: bool,
+    ) -> Result<()> {
+        let settings = IterationSettings {
+            absolute_tolerance: self.parameters.tolerance * self.size,
+            max_iterations: self.parameters.max_iterations.max(1) as usize,
+        };
+        let model = self.model.as_mut().expect("the model exists during a step");
+        let dynamics = self.dynamics.as_mut().unwrap();
         let gravity = Vector3::from(self.parameters.gravity);
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
+        let derivatives = &self.input_derivatives;
+        let tau = std::cell::Cell::new(tau0);
         let body = &model.body;
-        let loads =
-            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+        let loads = |x: &[f64], f: &mut [f64]| {
+            apply_loads(
+                body,
+                interfaces,
+                inputs,
+                Some((derivatives, tau.get())),
+                &gravity,
+                x,
+                f,
+            )
+        };
         let driving = &self.driving;
-        let t_c = current_communication_point;
         let prescribe = |t: f64, state: &mut DynamicState| {
             prescribe_motion(body, interfaces, driving, t - t_c, state)
         };
-        // Held inputs that jumped at this communication point: restart the scheme from the
-        // accelerations consistent with the new loads (second order under changing inputs).
-        if loads_changed(interfaces, &dynamics.loads, inputs)
-            || dynamics.gravity != self.parameters.gravity
-        {
-            let old_gravity = Vector3::from(dynamics.gravity);
-            let old_inputs = &dynamics.loads;
-            let old_loads = |x: &[f64], f: &mut [f64]| {
-                apply_loads(body, interfaces, old_inputs, &old_gravity, x, f)
-            };
-            generalized_alpha::restart_for_load_change(
-                &model.free,
-                &mut model.mass,
-                &old_loads,
-                &loads,
-                &mut dynamics.state,
-                &mut model.workspace,
-            );
-        }
         let problem = generalized_alpha::StepProblem {
             body,
             free: &model.free,
@@ -832,54 +1210,23 @@ impl Slave {
             loads: &loads,
             prescribe: &prescribe,
         };
-        let mut result = Ok(());
-        for _ in 0..substeps as usize {
-            let r = generalized_alpha::step(
+        for j in 0..m {
+            tau.set(if last_of_step && j + 1 == m {
+                big_h
+            } else {
+                tau0 + (j + 1) as f64 * hs
+            });
+            let report = generalized_alpha::step(
                 &problem,
                 &mut model.matrices[index],
-                h,
+                hs,
                 &mut dynamics.state,
                 &mut model.workspace,
-            );
-            match r {
-                Ok(report) => {
-                    self.statistics.0 += 1;
-                    self.statistics.1 += report.iterations as u64;
-                }
-                Err(e) => {
-                    result = Err(e);
-                    break;
-                }
-            }
+            )?;
+            self.statistics.0 += 1;
+            self.statistics.1 += report.iterations as u64;
         }
-        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
-            result = Err(Error::discard("the step produced non-finite positions"));
-        }
-        match result {
-            Ok(()) => {
-                dynamics.state.time = current_communication_point + big_h;
-                dynamics.loads.clone_from(&self.inputs);
-                dynamics.gravity = self.parameters.gravity;
-                self.outputs.valid = false;
-                Ok(())
-            }
-            Err(e) => {
-                dynamics.state.copy_from(self.backup.as_ref().unwrap());
-                let kind = e.kind;
-                let message = format!(
-                    "doStep from t = {current_communication_point} by {big_h}: {}; the state was rolled back to t = {current_communication_point}",
-                    e.message
-                );
-                Err(Error {
-                    kind: if kind == ErrorKind::Discard {
-                        ErrorKind::Discard
-                    } else {
-                        ErrorKind::Error
-                    },
-                    message,
-                })
-            }
-        }
+        Ok(())
     }
 
     /// The driving frames of the motion interfaces from the current inputs (no allocation unless
@@ -983,7 +1330,8 @@ impl Slave {
         Ok(())
     }
 
-    /// Index of the factorization for internal step `h` in the cache (factorising on a miss).
+    /// Index of the factorization for internal step `h` in the cache (factorising on a miss and
+    /// evicting the least recently used entry when [`MATRIX_CACHE_SIZE`] are kept).
     fn matrix_index(&mut self, h: f64) -> Result<usize> {
         self.ensure_model()?;
         let p = &self.parameters;
@@ -993,7 +1341,9 @@ impl Slave {
             .iter()
             .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
         {
-            return Ok(i);
+            // Most recently used last (a rotation of at most four entries: no allocation).
+            model.matrices[i..].rotate_left(1);
+            return Ok(model.matrices.len() - 1);
         }
         let started = std::time::Instant::now();
         let matrix = IterationMatrix::new(
@@ -1013,6 +1363,7 @@ impl Slave {
             ),
         });
         if model.matrices.len() >= MATRIX_CACHE_SIZE {
+            // The least recently used one.
             model.matrices.remove(0);
         }
         model.matrices.push(matrix);
@@ -1151,7 +1502,7 @@ impl Slave {
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
         let loads =
-            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, &gravity, x, f);
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, None, &gravity, x, f);
         generalized_alpha::initial_acceleration(
             body,
             &model.free,
@@ -1185,21 +1536,25 @@ impl Slave {
         let gravity = Vector3::from(dynamics.gravity);
         let interfaces = &self.interfaces;
         let loads_in = &dynamics.loads;
-        let loads =
-            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, loads_in, &gravity, x, f);
+        let loads = |x: &[f64], f: &mut [f64]| {
+            apply_loads(body, interfaces, loads_in, None, &gravity, x, f)
+        };
         let kin =
             generalized_alpha::residual(body, &model.free, state, &loads, &mut model.workspace);
         let residual = generalized_alpha::last_residual(&model.workspace);
 
         // Body outputs (DESIGN.md section 4).
         let m = body.total_mass;
-        let (mut com, mut vcom) = (Vector3::zeros(), Vector3::zeros());
+        let (mut com, mut vcom, mut acom) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
         for (i, &mi) in body.mass_row_sums.iter().enumerate() {
             com += mi * node(&state.position, i);
             vcom += mi * node(&state.velocity, i);
+            acom += mi * node(&state.acceleration, i);
         }
         com /= m;
         vcom /= m;
+        acom /= m;
+        self.outputs.body_acceleration = acom.into();
         let (mut angular, mut kinetic) = (Vector3::zeros(), 0.0);
         let ms = &body.mass_matrix;
         for i in 0..ms.n {
@@ -1276,6 +1631,7 @@ impl Slave {
             }
         }
         let finite = self.outputs.body.iter().all(|x| x.is_finite())
+            && self.outputs.body_acceleration.iter().all(|x| x.is_finite())
             && self
                 .outputs
                 .interfaces
@@ -1421,19 +1777,14 @@ fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
 }
 
 /// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
-/// torque distributed over its node set; added to `f`.
-/// Whether the force and torque inputs of a force interface differ between `old` and `new`.
-fn loads_changed(interfaces: &[Interface], old: &[Inputs], new: &[Inputs]) -> bool {
-    interfaces
-        .iter()
-        .zip(old.iter().zip(new))
-        .any(|(i, (a, b))| i.kind == InterfaceKind::Force && a[..6] != b[..6])
-}
-
+/// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
+/// torque distributed over its node set; added to `f`. With `extrapolation = (derivatives, τ)`
+/// the force inputs are taken `τ` seconds after the communication point (see [`extrapolate`]).
 fn apply_loads(
     body: &Body,
     interfaces: &[Interface],
     inputs: &[Inputs],
+    extrapolation: Option<(&[InputDerivatives], f64)>,
     gravity: &Vector3<f64>,
     x: &[f64],
     f: &mut [f64],
@@ -1441,11 +1792,35 @@ fn apply_loads(
     if gravity.norm_squared() > 0.0 {
         body.add_uniform_acceleration_load(gravity, f);
     }
-    for (interface, load) in interfaces.iter().zip(inputs) {
-        if interface.kind == InterfaceKind::Force && load.iter().any(|&v| v != 0.0) {
+    for (k, (interface, input)) in interfaces.iter().zip(inputs).enumerate() {
+        if interface.kind != InterfaceKind::Force {
+            continue;
+        }
+        let mut load = [0.0; 6];
+        load.copy_from_slice(&input[..6]);
+        if let Some((derivatives, tau)) = extrapolation {
+            let d = &derivatives[k];
+            for (s, value) in load.iter_mut().enumerate() {
+                if d[0][s] != 0.0 || d[1][s] != 0.0 {
+                    *value += d[0][s] * tau + 0.5 * d[1][s] * tau * tau;
+                }
+            }
+        }
+        if load.iter().any(|&v| v != 0.0) {
             let force = Vector3::new(load[0], load[1], load[2]);
             let torque = Vector3::new(load[3], load[4], load[5]);
             interface.set.distribute(x, &force, &torque, f);
+        }
+    }
+}
+
+/// A force interface's inputs `τ` seconds after the communication point: `u + u'·τ + u''·τ²/2`
+/// in the force and torque slots (the only ones with derivatives); the same arithmetic as
+/// [`apply_loads`], so the end-of-step loads match those the last internal step used.
+fn extrapolate(input: &mut Inputs, d: &InputDerivatives, tau: f64) {
+    for s in 0..6 {
+        if d[0][s] != 0.0 || d[1][s] != 0.0 {
+            input[s] += d[0][s] * tau + 0.5 * d[1][s] * tau * tau;
         }
     }
 }

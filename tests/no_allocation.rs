@@ -36,6 +36,7 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
         .map(|v| v.value_reference)
         .collect();
     let force_x = vr(&s, "tip.force[1]");
+    let tip_x = vr(&s, "tip.position[1]");
     let h = 1e-3;
     // First step at this communication step size (factorization allowed), then a step split into
     // two internal steps (another factorization allowed).
@@ -48,6 +49,11 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
         s.do_step(t, big).unwrap();
         t += big;
         s.set_real(force_x, k as f64).unwrap();
+        // Force inputs extrapolated over the step (fmi2SetRealInputDerivatives).
+        s.set_real_input_derivatives(&[force_x, force_x], &[1, 2], &[k as f64, -2.0 * k as f64])
+            .unwrap();
+        s.get_real_output_derivative(tip_x, 1).unwrap();
+        s.get_real_output_derivative(tip_x, 2).unwrap();
         for &vr in &names {
             s.get_real(vr).unwrap();
         }

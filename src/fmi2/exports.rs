@@ -548,21 +548,51 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     })
 }
 
-const NO_SERIALIZATION: &str = "FMU state serialization (canSerializeFMUstate=\"false\")";
+/// The live state behind `FMUstate`, or an error message.
+unsafe fn live_state<'a>(
+    inst: &mut Component,
+    function: &str,
+    FMUstate: fmi2FMUstate,
+) -> Result<&'a FmuState, fmi2Status> {
+    match (FMUstate as *const FmuState).as_ref() {
+        None => Err(inst.fail(function, "FMUstate is NULL")),
+        Some(s) if !s.is_valid() => Err(inst.fail(
+            function,
+            "FMUstate is not a live state of this FMU (freed, or from another FMU)",
+        )),
+        Some(s) => Ok(s),
+    }
+}
 
-/// `fmi2SerializedFMUstateSize`: not supported.
+/// `fmi2SerializedFMUstateSize`: the number of bytes `fmi2SerializeFMUstate` writes.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     c: fmi2Component,
     FMUstate: fmi2FMUstate,
     size: *mut usize,
 ) -> fmi2Status {
-    let _ = (FMUstate, size);
     const F: &str = "fmi2SerializedFMUstateSize";
-    call(c, F, |inst| inst.unsupported(F, NO_SERIALIZATION))
+    call(c, F, |inst| {
+        if size.is_null() {
+            return inst.fail(F, "size is NULL");
+        }
+        let state = match live_state(inst, F, FMUstate) {
+            Ok(s) => s,
+            Err(status) => return status,
+        };
+        match inst.serialize_snapshot(F, state) {
+            Ok(bytes) => {
+                *size = bytes.len();
+                fmi2Status::fmi2OK
+            }
+            Err(status) => status,
+        }
+    })
 }
 
-/// `fmi2SerializeFMUstate`: not supported.
+/// `fmi2SerializeFMUstate`: writes the state's portable bytes (layout:
+/// [`super::instance::SERIALIZED_MAGIC`]) to `serializedState`, which holds `size` bytes, at
+/// least `fmi2SerializedFMUstateSize`; bytes beyond the state are set to zero.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializeFMUstate(
     c: fmi2Component,
@@ -570,12 +600,37 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     serializedState: *mut fmi2Byte,
     size: usize,
 ) -> fmi2Status {
-    let _ = (FMUstate, serializedState, size);
     const F: &str = "fmi2SerializeFMUstate";
-    call(c, F, |inst| inst.unsupported(F, NO_SERIALIZATION))
+    call(c, F, |inst| {
+        let state = match live_state(inst, F, FMUstate) {
+            Ok(s) => s,
+            Err(status) => return status,
+        };
+        let bytes = match inst.serialize_snapshot(F, state) {
+            Ok(b) => b,
+            Err(status) => return status,
+        };
+        if size < bytes.len() {
+            return inst.fail(
+                F,
+                &format!(
+                    "size = {size} rejected: the state needs {} bytes (fmi2SerializedFMUstateSize)",
+                    bytes.len()
+                ),
+            );
+        }
+        let Some(out) = slice_out(serializedState as *mut u8, size) else {
+            return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
+        };
+        out[..bytes.len()].copy_from_slice(&bytes);
+        out[bytes.len()..].fill(0);
+        fmi2Status::fmi2OK
+    })
 }
 
-/// `fmi2DeSerializeFMUstate`: not supported.
+/// `fmi2DeSerializeFMUstate`: a state from bytes of `fmi2SerializeFMUstate` (of an instance of
+/// the same FMU, possibly in another process); a NULL `*FMUstate` receives a new state, a
+/// non-NULL one is overwritten. Bytes of another body or version are refused with a message.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,
@@ -583,9 +638,32 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     size: usize,
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
-    let _ = (serializedState, size, FMUstate);
     const F: &str = "fmi2DeSerializeFMUstate";
-    call(c, F, |inst| inst.unsupported(F, NO_SERIALIZATION))
+    call(c, F, |inst| {
+        if FMUstate.is_null() {
+            return inst.fail(F, "FMUstate is NULL");
+        }
+        let Some(bytes) = slice_in(serializedState as *const u8, size) else {
+            return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
+        };
+        let snapshot = match inst.deserialize_snapshot(bytes) {
+            Ok(s) => s,
+            Err(status) => return status,
+        };
+        let existing = *FMUstate as *mut FmuState;
+        if existing.is_null() {
+            *FMUstate = Box::into_raw(Box::new(snapshot)) as fmi2FMUstate;
+        } else {
+            if !(*existing).is_valid() {
+                return inst.fail(
+                    F,
+                    "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
+                );
+            }
+            *existing = snapshot;
+        }
+        fmi2Status::fmi2OK
+    })
 }
 
 /// `fmi2GetDirectionalDerivative`: not supported (`providesDirectionalDerivative="false"`).
@@ -619,7 +697,8 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
 // ---------------------------------------------------------------------------------------------
 // Co-simulation
 
-/// `fmi2SetRealInputDerivatives`: not supported (`canInterpolateInputs="false"`).
+/// `fmi2SetRealInputDerivatives` (`canInterpolateInputs="true"`): derivatives of force inputs,
+/// see [`crate::slave::Slave::set_real_input_derivatives`].
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     c: fmi2Component,
@@ -628,14 +707,23 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     order: *const fmi2Integer,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    let _ = (vr, nvr, order, value);
     const F: &str = "fmi2SetRealInputDerivatives";
     call(c, F, |inst| {
-        inst.unsupported(F, "input derivatives (canInterpolateInputs=\"false\")")
+        match (
+            slice_in(vr, nvr),
+            slice_in(order, nvr),
+            slice_in(value, nvr),
+        ) {
+            (Some(vrs), Some(orders), Some(values)) => {
+                inst.set_real_input_derivatives(vrs, orders, values)
+            }
+            _ => inst.fail(F, &format!("vr, order or value is NULL with nvr = {nvr}")),
+        }
     })
 }
 
-/// `fmi2GetRealOutputDerivatives`: not supported (`maxOutputDerivativeOrder="0"`).
+/// `fmi2GetRealOutputDerivatives` (`maxOutputDerivativeOrder="2"`): see
+/// [`crate::slave::Slave::get_real_output_derivative`] for which outputs have derivatives.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     c: fmi2Component,
@@ -644,10 +732,18 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     order: *const fmi2Integer,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    let _ = (vr, nvr, order, value);
     const F: &str = "fmi2GetRealOutputDerivatives";
     call(c, F, |inst| {
-        inst.unsupported(F, "output derivatives (maxOutputDerivativeOrder=\"0\")")
+        match (
+            slice_in(vr, nvr),
+            slice_in(order, nvr),
+            slice_out(value, nvr),
+        ) {
+            (Some(vrs), Some(orders), Some(values)) => {
+                inst.get_real_output_derivatives(vrs, orders, values)
+            }
+            _ => inst.fail(F, &format!("vr, order or value is NULL with nvr = {nvr}")),
+        }
     })
 }
 
@@ -665,16 +761,14 @@ pub unsafe extern "C" fn fmi2DoStep(
     })
 }
 
-/// `fmi2CancelStep`: steps are synchronous, so there is never a step to cancel.
+/// `fmi2CancelStep`: FMI 2.0 allows it only in the state StepInProgress, after `fmi2DoStep`
+/// returned `fmi2Pending`. Steps here are synchronous (`canRunAsynchronuously="false"`), so that
+/// state never occurs and every call is a calling-sequence error (`fmi2Error`, as the Reference
+/// FMUs do); the instance is unchanged.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> fmi2Status {
     const F: &str = "fmi2CancelStep";
-    call(c, F, |inst| {
-        inst.unsupported(
-            F,
-            "fmi2DoStep is synchronous (never returns fmi2Pending), so no step is in progress",
-        )
-    })
+    call(c, F, |inst| inst.cancel_step())
 }
 
 /// Writes `result` to `value` (checked for NULL) or returns its error status.

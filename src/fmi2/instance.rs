@@ -61,6 +61,25 @@ pub trait CoSimSlave {
     fn reset(&mut self);
     fn get_state(&self) -> Self::State;
     fn set_state(&mut self, state: &Self::State) -> Result<()>;
+    /// Appends the portable byte form of `state` (see `fmi2SerializeFMUstate`).
+    fn state_to_bytes(&self, state: &Self::State, out: &mut Vec<u8>);
+    /// Reads what [`CoSimSlave::state_to_bytes`] wrote, checked against this slave.
+    fn state_from_bytes(&self, bytes: &[u8]) -> Result<Self::State>;
+    /// Checks a value for a Real variable without setting it (`Ok` if `set_real` would accept it).
+    fn check_real(&self, vr: u32, value: f64) -> Result<()> {
+        let _ = (vr, value);
+        Ok(())
+    }
+    /// `fmi2SetRealInputDerivatives` (value references are Real inputs, orders ≥ 1, checked by
+    /// the caller): all or nothing.
+    fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Result<()>;
+    /// `fmi2GetRealOutputDerivatives` for one output.
+    fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64>;
     /// Hands the slave's pending log messages (category, text) to `sink`.
     fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
         let _ = sink;
@@ -122,6 +141,26 @@ impl CoSimSlave for Slave {
     fn set_state(&mut self, state: &SlaveState) -> Result<()> {
         Slave::set_state(self, state)
     }
+    fn state_to_bytes(&self, state: &SlaveState, out: &mut Vec<u8>) {
+        state.write_bytes(out)
+    }
+    fn state_from_bytes(&self, bytes: &[u8]) -> Result<SlaveState> {
+        Slave::state_from_bytes(self, bytes)
+    }
+    fn check_real(&self, vr: u32, value: f64) -> Result<()> {
+        Slave::check_real(self, vr, value)
+    }
+    fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Result<()> {
+        Slave::set_real_input_derivatives(self, vrs, orders, values)
+    }
+    fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64> {
+        Slave::get_real_output_derivative(self, vr, order)
+    }
     fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
         for e in Slave::drain_events(self) {
             sink(e.category, &e.message);
@@ -158,6 +197,14 @@ const GET: &[MachineState] = &[
     M::Error,
 ];
 const SET: &[MachineState] = &[M::Instantiated, M::InitializationMode, M::StepComplete];
+/// `fmi2GetRealOutputDerivatives`: outputs of a computed state (as the Reference FMUs).
+const OUTPUT_DERIVATIVES: &[MachineState] = &[
+    M::StepComplete,
+    M::StepFailed,
+    M::StepCanceled,
+    M::Terminated,
+    M::Error,
+];
 const STATUS: &[MachineState] = &[
     M::StepComplete,
     M::StepFailed,
@@ -176,6 +223,48 @@ const ANY_BUT_FATAL: &[MachineState] = &[
 
 /// Identifies a [`Snapshot`] made by this crate (a cheap guard against foreign pointers).
 const SNAPSHOT_MAGIC: u64 = 0x666c_6578_6d75_7374; // "flexmust"
+
+/// The first bytes of a serialized FMU state.
+///
+/// Layout of `fmi2SerializeFMUstate`'s bytes (little-endian): the magic `FLEXBODY` (8 bytes),
+/// the format version [`SERIALIZED_FORMAT`] (u32), the GUID (u32 length, UTF-8 bytes), the
+/// calling-sequence state (u8) and the termination flag (u8), the payload length (u64) and the
+/// slave's payload (`src/slave/state_bytes.rs`: positions, velocities, accelerations,
+/// pseudo-accelerations, multipliers, inputs and their derivatives, parameters, counters as f64,
+/// i32 and u64). The GUID covers the body file, the variable table and the crate version, so a
+/// state of another body or another version is refused by name.
+pub const SERIALIZED_MAGIC: &[u8; 8] = b"FLEXBODY";
+/// Version of the serialized layout (header and payload together: bump on any change).
+pub const SERIALIZED_FORMAT: u32 = 1;
+/// Fixed bytes of the header besides the GUID.
+const SERIALIZED_HEADER: usize = 8 + 4 + 4 + 1 + 1 + 8;
+
+fn machine_state_code(m: MachineState) -> u8 {
+    match m {
+        M::Instantiated => 0,
+        M::InitializationMode => 1,
+        M::StepComplete => 2,
+        M::StepFailed => 3,
+        M::StepCanceled => 4,
+        M::Terminated => 5,
+        M::Error => 6,
+        M::Fatal => 7,
+    }
+}
+
+fn machine_state_from_code(code: u8) -> Option<MachineState> {
+    Some(match code {
+        0 => M::Instantiated,
+        1 => M::InitializationMode,
+        2 => M::StepComplete,
+        3 => M::StepFailed,
+        4 => M::StepCanceled,
+        5 => M::Terminated,
+        6 => M::Error,
+        7 => M::Fatal,
+        _ => return None,
+    })
+}
 
 /// What `fmi2GetFMUstate` saves: the slave's snapshot and the calling-sequence state, so that
 /// `fmi2SetFMUstate` after an `fmi2Discard` returns to StepComplete.
@@ -248,12 +337,20 @@ impl<S: CoSimSlave> FromSlave<S> for bool {
 pub trait ToSlave<S: CoSimSlave>: Sized + Copy {
     const TYPE: VariableType;
     fn set(slave: &mut S, vr: u32, value: Self) -> Result<()>;
+    /// Whether `set` would accept the value (checked for the whole array before setting any).
+    fn check(slave: &S, vr: u32, value: Self) -> Result<()> {
+        let _ = (slave, vr, value);
+        Ok(())
+    }
 }
 
 impl<S: CoSimSlave> ToSlave<S> for f64 {
     const TYPE: VariableType = VariableType::Real;
     fn set(slave: &mut S, vr: u32, value: f64) -> Result<()> {
         slave.set_real(vr, value)
+    }
+    fn check(slave: &S, vr: u32, value: f64) -> Result<()> {
+        slave.check_real(vr, value)
     }
 }
 
@@ -570,9 +667,9 @@ impl<S: CoSimSlave> Instance<S> {
         fmi2Status::fmi2OK
     }
 
-    /// `fmi2Set{Real,Integer,Boolean}`: checks every value reference and its settability in the
-    /// current state before setting any value; then sets them in order (the slave rejects bad
-    /// values with a message naming the variable).
+    /// `fmi2Set{Real,Integer,Boolean}`: checks every value reference, its settability in the
+    /// current state and (Reals) its value before setting any value; then sets them in order
+    /// (the slave rejects bad values with a message naming the variable).
     pub fn set_values<T: ToSlave<S>>(
         &mut self,
         function: &str,
@@ -591,6 +688,11 @@ impl<S: CoSimSlave> Instance<S> {
             };
             if let Some(reason) = reason {
                 return self.fail(function, &reason);
+            }
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
+            if let Err(e) = T::check(&self.slave, vr, x) {
+                return self.report(function, &e);
             }
         }
         for (&vr, &x) in vrs.iter().zip(values) {
@@ -652,10 +754,85 @@ impl<S: CoSimSlave> Instance<S> {
         }
     }
 
-    /// `fmi2CancelStep` and the other functions this FMU does not support: `fmi2Error` with a
+    /// `fmi2SetRealInputDerivatives` (`canInterpolateInputs="true"`): allowed where inputs may be
+    /// set; every value reference must be a Real input and every order 1 or 2 (what the slave
+    /// can use); all or nothing.
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> fmi2Status {
+        const F: &str = "fmi2SetRealInputDerivatives";
+        if let Err(s) = self.check_state(F, SET) {
+            return s;
+        }
+        for (&vr, &order) in vrs.iter().zip(orders) {
+            let reason = match self.lookup(VariableType::Real, vr) {
+                Ok(v) if v.causality != Causality::Input => {
+                    Some(format!("{} (value reference {vr}) is not an input", v.name))
+                }
+                Ok(v) if order < 1 => Some(format!(
+                    "order = {order} rejected for {} (value reference {vr}): must be at least 1",
+                    v.name
+                )),
+                Ok(_) => None,
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(F, &reason);
+            }
+        }
+        match self.slave.set_real_input_derivatives(vrs, orders, values) {
+            Ok(()) => fmi2Status::fmi2OK,
+            Err(e) => self.report(F, &e),
+        }
+    }
+
+    /// `fmi2GetRealOutputDerivatives` (`maxOutputDerivativeOrder="2"`): every value reference
+    /// must be a Real output; the slave says which derivatives exist.
+    pub fn get_real_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &mut [f64],
+    ) -> fmi2Status {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        if let Err(s) = self.check_state(F, OUTPUT_DERIVATIVES) {
+            return s;
+        }
+        for ((&vr, &order), out) in vrs.iter().zip(orders).zip(values.iter_mut()) {
+            if let Err(e) = self.lookup(VariableType::Real, vr) {
+                return self.fail(F, &e);
+            }
+            match self.slave.get_real_output_derivative(vr, order) {
+                Ok(x) if x.is_finite() => *out = x,
+                Ok(x) => {
+                    return self.fail(F, &format!("the derivative of value reference {vr} is {x}"))
+                }
+                Err(e) => return self.report(F, &e),
+            }
+        }
+        fmi2Status::fmi2OK
+    }
+
+    /// Functions this FMU does not support (`fmi2GetDirectionalDerivative`): `fmi2Error` with a
     /// message.
     pub fn unsupported(&mut self, function: &str, why: &str) -> fmi2Status {
         self.fail(function, &format!("not supported: {why}"))
+    }
+
+    /// `fmi2CancelStep`: only allowed in StepInProgress, which this synchronous FMU never enters;
+    /// so always an `fmi2Error` that names the state, and nothing changes.
+    pub fn cancel_step(&mut self) -> fmi2Status {
+        const F: &str = "fmi2CancelStep";
+        let state = self.state;
+        self.fail(
+            F,
+            &format!(
+                "not allowed in state {state:?}: only while an asynchronous fmi2DoStep is pending (StepInProgress), which never happens here: fmi2DoStep is synchronous (canRunAsynchronuously=\"false\") and never returns fmi2Pending"
+            ),
+        )
     }
 
     /// `fmi2GetStatus`: `fmi2DoStepStatus` is only defined after `fmi2Pending`, which this
@@ -784,6 +961,127 @@ impl<S: CoSimSlave> Instance<S> {
             }
             Err(e) => self.report(F, &e),
         }
+    }
+
+    /// `fmi2SerializeFMUstate`: the portable bytes of `snapshot` (layout in [`SERIALIZED_MAGIC`]).
+    pub fn serialize_snapshot(
+        &mut self,
+        function: &str,
+        snapshot: &Snapshot<S::State>,
+    ) -> std::result::Result<Vec<u8>, fmi2Status> {
+        self.check_state(function, ANY_BUT_FATAL)?;
+        if !snapshot.is_valid() {
+            return Err(self.fail(
+                function,
+                "FMUstate is not a live state of this FMU (freed, or from another FMU)",
+            ));
+        }
+        let mut payload = Vec::new();
+        self.slave.state_to_bytes(&snapshot.slave, &mut payload);
+        let guid = snapshot.guid.as_bytes();
+        let mut out = Vec::with_capacity(SERIALIZED_HEADER + guid.len() + payload.len());
+        out.extend_from_slice(SERIALIZED_MAGIC);
+        out.extend_from_slice(&SERIALIZED_FORMAT.to_le_bytes());
+        out.extend_from_slice(&(guid.len() as u32).to_le_bytes());
+        out.extend_from_slice(guid);
+        out.push(machine_state_code(snapshot.machine));
+        out.push(u8::from(snapshot.terminate_requested));
+        out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+        out.extend_from_slice(&payload);
+        Ok(out)
+    }
+
+    /// `fmi2DeSerializeFMUstate`: a snapshot from bytes of [`Instance::serialize_snapshot`],
+    /// checked: magic, format version, GUID (the same body and build), then the slave's payload.
+    /// Bytes after the declared payload must be zero (an importer may pass a larger buffer).
+    pub fn deserialize_snapshot(
+        &mut self,
+        bytes: &[u8],
+    ) -> std::result::Result<Snapshot<S::State>, fmi2Status> {
+        const F: &str = "fmi2DeSerializeFMUstate";
+        self.check_state(F, ANY_BUT_FATAL)?;
+        match self.parse_snapshot(bytes) {
+            Ok(s) => Ok(s),
+            Err(message) => Err(self.fail(F, &message)),
+        }
+    }
+
+    fn parse_snapshot(&self, bytes: &[u8]) -> std::result::Result<Snapshot<S::State>, String> {
+        let truncated = || {
+            format!(
+                "the serialized FMU state is truncated ({} bytes) or not one of this FMU",
+                bytes.len()
+            )
+        };
+        if bytes.len() < SERIALIZED_MAGIC.len() || &bytes[..8] != SERIALIZED_MAGIC {
+            return Err(format!(
+                "the {} bytes are not a serialized state of this FMU (they do not start with \"FLEXBODY\")",
+                bytes.len()
+            ));
+        }
+        let u32_at = |at: usize| {
+            bytes
+                .get(at..at + 4)
+                .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+        };
+        let format = u32_at(8).ok_or_else(truncated)?;
+        if format != SERIALIZED_FORMAT {
+            return Err(format!(
+                "the serialized FMU state has format version {format}; this FMU reads version {SERIALIZED_FORMAT} (it was written by another version of flexbody)"
+            ));
+        }
+        let guid_len = u32_at(12).ok_or_else(truncated)? as usize;
+        let guid_end = 16usize.checked_add(guid_len).ok_or_else(truncated)?;
+        let guid = bytes.get(16..guid_end).ok_or_else(truncated)?;
+        let guid = String::from_utf8_lossy(guid).into_owned();
+        if guid != self.slave.guid() {
+            return Err(format!(
+                "the serialized FMU state belongs to an FMU with GUID {guid}; this instance has GUID {} (another body, body file or version of flexbody)",
+                self.slave.guid()
+            ));
+        }
+        let rest = &bytes[guid_end..];
+        if rest.len() < 10 {
+            return Err(truncated());
+        }
+        let machine = machine_state_from_code(rest[0]).ok_or_else(|| {
+            format!(
+                "the serialized FMU state has an unknown calling-sequence state {}",
+                rest[0]
+            )
+        })?;
+        let terminate_requested = match rest[1] {
+            0 => false,
+            1 => true,
+            b => {
+                return Err(format!(
+                    "the serialized FMU state has {b} as its termination flag: not 0 or 1"
+                ))
+            }
+        };
+        let len = u64::from_le_bytes(rest[2..10].try_into().unwrap());
+        let payload_end = usize::try_from(len)
+            .ok()
+            .and_then(|l| l.checked_add(10))
+            .filter(|&end| end <= rest.len())
+            .ok_or_else(truncated)?;
+        if rest[payload_end..].iter().any(|&b| b != 0) {
+            return Err(format!(
+                "the serialized FMU state is followed by {} bytes that are not zero",
+                rest.len() - payload_end
+            ));
+        }
+        let slave = self
+            .slave
+            .state_from_bytes(&rest[10..payload_end])
+            .map_err(|e| e.message)?;
+        Ok(Snapshot {
+            magic: SNAPSHOT_MAGIC,
+            guid,
+            slave,
+            machine,
+            terminate_requested,
+        })
     }
 
     /// Checks the state for `fmi2FreeFMUstate`.
@@ -928,6 +1226,41 @@ mod tests {
             self.time = s.time;
             self.reals = s.reals.clone();
             Ok(())
+        }
+        fn state_to_bytes(&self, s: &MockState, out: &mut Vec<u8>) {
+            out.extend_from_slice(&s.time.to_le_bytes());
+            let mut reals: Vec<_> = s.reals.iter().collect();
+            reals.sort_by_key(|(vr, _)| **vr);
+            for (vr, x) in reals {
+                out.extend_from_slice(&vr.to_le_bytes());
+                out.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        fn state_from_bytes(&self, bytes: &[u8]) -> Result<MockState> {
+            if bytes.len() < 8 || !(bytes.len() - 8).is_multiple_of(12) {
+                return Err(Error::new("mock state: bad length"));
+            }
+            let time = f64::from_le_bytes(bytes[..8].try_into().unwrap());
+            let reals = bytes[8..]
+                .chunks(12)
+                .map(|c| {
+                    (
+                        u32::from_le_bytes(c[..4].try_into().unwrap()),
+                        f64::from_le_bytes(c[4..].try_into().unwrap()),
+                    )
+                })
+                .collect();
+            Ok(MockState { time, reals })
+        }
+        fn set_real_input_derivatives(&mut self, _: &[u32], _: &[i32], _: &[f64]) -> Result<()> {
+            Ok(())
+        }
+        fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64> {
+            if order == 1 {
+                Ok(self.reals.get(&vr).copied().unwrap_or(0.0) * 10.0)
+            } else {
+                Err(Error::new("no such derivative"))
+            }
         }
     }
 
@@ -1304,6 +1637,81 @@ mod tests {
         assert!(
             last_message(&log).contains("fmi2DoStep: internal error (panic): index out of bounds")
         );
+    }
+
+    #[test]
+    fn serialized_snapshot_round_trips_and_damaged_bytes_are_refused() {
+        let (mut i, log) = initialized();
+        assert_eq!(i.do_step(0.0, 0.25), OK);
+        let s = i.snapshot("fmi2GetFMUstate").unwrap();
+        let bytes = i.serialize_snapshot("fmi2SerializeFMUstate", &s).unwrap();
+        assert_eq!(&bytes[..8], b"FLEXBODY");
+        let back = i.deserialize_snapshot(&bytes).unwrap();
+        assert_eq!(back.slave, s.slave);
+        assert_eq!(
+            (back.machine, back.guid.as_str()),
+            (M::StepComplete, "{mock}")
+        );
+        // Trailing zeros (a larger buffer) are fine; anything else is not.
+        let mut padded = bytes.clone();
+        padded.extend_from_slice(&[0; 7]);
+        assert!(i.deserialize_snapshot(&padded).is_ok());
+        let cases: Vec<(Vec<u8>, &str)> = vec![
+            (bytes[..bytes.len() - 1].to_vec(), "truncated"),
+            (b"NOTFLEXB".to_vec(), "do not start with"),
+            (
+                [&bytes[..8], &2u32.to_le_bytes(), &bytes[12..]].concat(),
+                "format version 2",
+            ),
+            (
+                [&bytes[..16], b"{mocx}", &bytes[22..]].concat(),
+                "GUID {mocx}",
+            ),
+            ([&bytes[..], &[1]].concat(), "not zero"),
+        ];
+        for (bad, fragment) in cases {
+            assert_eq!(i.deserialize_snapshot(&bad).err(), Some(ERR), "{fragment}");
+            let m = last_message(&log);
+            assert!(m.contains(fragment), "{fragment}: {m}");
+        }
+        assert_eq!(i.state(), M::StepComplete);
+    }
+
+    #[test]
+    fn cancel_step_is_a_calling_sequence_error_in_every_state() {
+        let (mut i, log) = initialized();
+        assert_eq!(i.cancel_step(), ERR);
+        assert!(last_message(&log).contains("StepInProgress"));
+        assert_eq!(i.state(), M::StepComplete);
+        assert_eq!(i.do_step(0.0, 0.1), OK);
+    }
+
+    #[test]
+    fn derivative_calls_check_causality_order_and_state() {
+        let (mut i, log) = instance(false);
+        let mut x = [0.0];
+        assert_eq!(i.set_real_input_derivatives(&[TIP_FX], &[1], &[2.0]), OK);
+        assert_eq!(i.set_real_input_derivatives(&[BODY_X], &[1], &[2.0]), ERR);
+        assert!(
+            last_message(&log).contains("body.position[1] (value reference 40) is not an input")
+        );
+        assert_eq!(i.set_real_input_derivatives(&[TIP_FX], &[0], &[2.0]), ERR);
+        assert!(last_message(&log).contains("order = 0"));
+        assert_eq!(
+            i.set_real_input_derivatives(&[NONLINEAR], &[1], &[2.0]),
+            ERR
+        );
+        assert!(last_message(&log).contains("Boolean"));
+        assert_eq!(i.get_real_output_derivatives(&[BODY_X], &[1], &mut x), ERR);
+        assert!(last_message(&log).contains("state Instantiated"));
+        let (mut i, log) = initialized();
+        assert_eq!(i.do_step(0.0, 0.5), OK);
+        assert_eq!(i.get_real_output_derivatives(&[BODY_X], &[1], &mut x), OK);
+        assert_eq!(x, [5.0]);
+        assert_eq!(i.get_real_output_derivatives(&[BODY_X], &[2], &mut x), ERR);
+        assert!(last_message(&log).contains("no such derivative"));
+        assert_eq!(i.terminate(), OK);
+        assert_eq!(i.set_real_input_derivatives(&[TIP_FX], &[1], &[2.0]), ERR);
     }
 
     #[test]

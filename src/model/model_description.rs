@@ -110,7 +110,9 @@ pub fn model_description(
     );
     let _ = writeln!(
         x,
-        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"false\" providesDirectionalDerivative=\"false\"/>",
+        // Capabilities: what src/fmi2 and src/slave.rs implement (MAX_OUTPUT_DERIVATIVE_ORDER = 2,
+        // force-input derivatives up to order 2, serialized states).
+        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"true\" maxOutputDerivativeOrder=\"2\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
         a(MODEL_IDENTIFIER)
     );
 
@@ -450,10 +452,10 @@ mod tests {
         for (k, v) in [
             ("canHandleVariableCommunicationStepSize", "true"),
             ("canGetAndSetFMUstate", "true"),
-            ("canSerializeFMUstate", "false"),
+            ("canSerializeFMUstate", "true"),
             ("canNotUseMemoryManagementFunctions", "true"),
-            ("canInterpolateInputs", "false"),
-            ("maxOutputDerivativeOrder", "0"),
+            ("canInterpolateInputs", "true"),
+            ("maxOutputDerivativeOrder", "2"),
             ("providesDirectionalDerivative", "false"),
         ] {
             assert_eq!(cs.attributes[k], v, "{k}");

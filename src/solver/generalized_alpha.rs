@@ -705,6 +705,10 @@ pub fn initial_acceleration(
 /// scheme first order under inputs that change (`tests/convergence_order.rs`). For a linear
 /// system this is exact superposition: the jump's response is a fresh start from rest with
 /// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation.
+///
+/// The slave does not call it: restarting at every jump of held inputs destabilised the
+/// iterated coupling of two FMUs (see `Slave::do_step`); it is kept for importers' schemes that
+/// want the zero-order-hold response of one FMU to second order.
 pub fn restart_for_load_change(
     free: &FreeNodes,
     mass: &mut ConsistentAcceleration,

@@ -15,6 +15,7 @@ from fmpy import calloc, free
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (
     FMU2Slave,
+    fmi2CoSimulation,
     fmi2CallbackAllocateMemoryTYPE,
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
@@ -55,10 +56,14 @@ _next_environment = [0x1000]
 class Instance:
     """One instantiated co-simulation slave with a message log of its own."""
 
-    def __init__(self, unzipdir, model_description, name):
+    def __init__(self, unzipdir, model_description, name, resource_location=None, visible=False, call_logger=None):
+        """`resource_location`: a URI to pass instead of fmpy's `file://` one (e.g. OMSimulator's
+        four-slash `file:////<dir>`); `call_logger`: fmpy's `fmiCallLogger` (sees every call's
+        status, fmi2Warning included)."""
         self.name = name
         self.model_description = model_description
         self.vr = {v.name: v.valueReference for v in model_description.modelVariables}
+        self.types = {v.name: v.type for v in model_description.modelVariables}
         self.real_outputs = [
             v.name for v in model_description.modelVariables if v.causality == "output" and v.type == "Real"
         ]
@@ -75,9 +80,19 @@ class Instance:
             unzipDirectory=unzipdir,
             modelIdentifier=model_description.coSimulation.modelIdentifier,
             instanceName=name,
+            fmiCallLogger=call_logger,
         )
-        # FMU2Slave.instantiate keeps a reference to the callbacks for the instance's lifetime.
-        self.fmu.instantiate(loggingOn=True, callbacks=callbacks)
+        if resource_location is None:
+            # FMU2Slave.instantiate keeps a reference to the callbacks for the instance's lifetime.
+            self.fmu.instantiate(visible=visible, loggingOn=True, callbacks=callbacks)
+        else:
+            self.fmu.callbacks = callbacks
+            self.fmu.component = self.fmu.fmi2Instantiate(
+                name.encode("utf-8"), fmi2CoSimulation, model_description.guid.encode("utf-8"),
+                resource_location.encode("utf-8"), byref(callbacks), visible, True,
+            )
+            if self.fmu.component is None:
+                raise Exception(f"fmi2Instantiate returned NULL for {resource_location}")
         self.time = 0.0
 
     def messages(self, status=None) -> list[LogRecord]:
@@ -94,7 +109,14 @@ class Instance:
         self.time = start_time
 
     def set(self, name, value):
-        self.fmu.setReal([self.vr[name]], [float(value)])
+        """Sets a Real, Integer or Boolean variable by name."""
+        kind = self.types[name]
+        if kind == "Integer":
+            self.fmu.setInteger([self.vr[name]], [int(value)])
+        elif kind == "Boolean":
+            self.fmu.setBoolean([self.vr[name]], [bool(value)])
+        else:
+            self.fmu.setReal([self.vr[name]], [float(value)])
 
     def get(self, name) -> float:
         return self.fmu.getReal([self.vr[name]])[0]

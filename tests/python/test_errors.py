@@ -68,3 +68,47 @@ def test_nan_input_is_rejected_and_named(slave):
     # The NaN was not stored: the next steps stay finite.
     assert_runs(slave)
     assert math.isfinite(slave.get("tip.position[1]"))
+
+
+@pytest.mark.parametrize(
+    "name, value, text, reason",
+    [
+        ("material.youngsModulus", 0.0, "= 0 rejected", "must be positive"),
+        ("material.youngsModulus", math.inf, "= inf rejected", "not a finite number"),
+        ("material.poissonRatio", 0.5, "= 0.5 rejected", "must lie in (-1, 0.5)"),
+        ("material.poissonRatio", -1.0, "= -1 rejected", "must lie in (-1, 0.5)"),
+        ("material.density", -1.0, "= -1 rejected", "must be positive"),
+        ("damping.alpha", -0.1, "= -0.1 rejected", "must not be negative"),
+        ("damping.beta", math.nan, "= NaN rejected", "not a finite number"),
+        ("solver.stepSize", 0.0, "= 0 rejected", "must be positive"),
+        ("solver.tolerance", 0.0, "= 0 rejected", "must lie in (0, 1)"),
+        ("solver.rhoInf", 2.0, "= 2 rejected", "must lie in [0, 1]"),
+    ],
+)
+def test_out_of_range_parameter_is_named_and_not_kept(slave, name, value, text, reason):
+    # In the Instantiated state, as importers set start values; the rejected value is not kept.
+    with pytest.raises(FMICallException) as error:
+        slave.set(name, value)
+    assert error.value.status == fmi2Error
+    assert_logged_error(slave, f"{name} {text}", reason)
+    slave.initialize()
+    assert math.isfinite(slave.get(name))
+    assert_runs(slave)
+
+
+def test_wrong_type_and_wrong_state_are_named(slave):
+    max_iterations = slave.vr["solver.maxIterations"]
+    with pytest.raises(FMICallException):
+        slave.fmu.setReal([max_iterations], [3.0])
+    assert_logged_error(slave, "is the Integer variable solver.maxIterations, not a Real variable")
+    with pytest.raises(FMICallException):
+        slave.fmu.setInteger([max_iterations], [0])
+    assert_logged_error(slave, "solver.maxIterations = 0 rejected")
+    slave.initialize()
+    with pytest.raises(FMICallException):
+        slave.set("material.youngsModulus", 1e9)
+    assert_logged_error(slave, "material.youngsModulus is a fixed parameter", "state StepComplete")
+    with pytest.raises(FMICallException):
+        slave.fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=-H)
+    assert_logged_error(slave, "communicationStepSize = -0.001 rejected")
+    assert_runs(slave)

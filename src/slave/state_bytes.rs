@@ -1,0 +1,348 @@
+//! The portable byte form of a [`SlaveState`] (the payload of `fmi2SerializeFMUstate`; the FMI
+//! layer adds the header with the magic, the format version and the GUID).
+//!
+//! Layout, all little-endian, no padding, no pointers (so the bytes of equal states are equal):
+//!
+//! | field | encoding |
+//! | --- | --- |
+//! | payload format | u32 = [`PAYLOAD_FORMAT`] |
+//! | interfaces `n` | u32 |
+//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth: i32; nonlinear forces: u8 |
+//! | inputs | `n × 30` f64 (value-reference slot order) |
+//! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
+//! | start time | f64 |
+//! | counters | internal steps, iterations, retries: u64 |
+//! | dynamics present | u8 (0 before initialization) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64 |
+//!
+//! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
+//! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
+//! with a message, never a panic or a NaN later.
+
+use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState};
+use crate::error::{Error, Result};
+use crate::fem::IsotropicMaterial;
+use crate::model::variables::FixedKey;
+use crate::solver::generalized_alpha::DynamicState;
+
+/// Version of the payload layout above; bump it when the layout changes.
+pub const PAYLOAD_FORMAT: u32 = 1;
+
+struct Writer<'a>(&'a mut Vec<u8>);
+
+impl Writer<'_> {
+    fn f64(&mut self, x: f64) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn f64s(&mut self, xs: &[f64]) {
+        xs.iter().for_each(|&x| self.f64(x));
+    }
+    fn u64(&mut self, x: u64) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn u32(&mut self, x: u32) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn i32(&mut self, x: i32) {
+        self.0.extend_from_slice(&x.to_le_bytes());
+    }
+    fn u8(&mut self, x: u8) {
+        self.0.push(x);
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
+        let end = self.at + N;
+        let chunk = self.bytes.get(self.at..end).ok_or_else(|| {
+            Error::new(format!(
+                "the serialized FMU state is truncated: {} bytes, {what} needs bytes {}..{end}",
+                self.bytes.len(),
+                self.at
+            ))
+        })?;
+        self.at = end;
+        Ok(chunk.try_into().expect("N bytes"))
+    }
+    fn f64(&mut self, what: &str) -> Result<f64> {
+        let x = f64::from_le_bytes(self.take::<8>(what)?);
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(Error::new(format!(
+                "the serialized FMU state holds {x} for {what} (byte {}): not a finite number",
+                self.at - 8
+            )))
+        }
+    }
+    fn f64s(&mut self, out: &mut [f64], what: &str) -> Result<()> {
+        for x in out {
+            *x = self.f64(what)?;
+        }
+        Ok(())
+    }
+    fn u64(&mut self, what: &str) -> Result<u64> {
+        Ok(u64::from_le_bytes(self.take::<8>(what)?))
+    }
+    fn u32(&mut self, what: &str) -> Result<u32> {
+        Ok(u32::from_le_bytes(self.take::<4>(what)?))
+    }
+    fn i32(&mut self, what: &str) -> Result<i32> {
+        Ok(i32::from_le_bytes(self.take::<4>(what)?))
+    }
+    fn u8(&mut self, what: &str) -> Result<u8> {
+        Ok(self.take::<1>(what)?[0])
+    }
+    /// A count that must equal `expected` (a property of this body).
+    fn count(&mut self, expected: usize, what: &str) -> Result<()> {
+        let n = self.u64(what)?;
+        if n == expected as u64 {
+            Ok(())
+        } else {
+            Err(Error::new(format!(
+                "the serialized FMU state has {n} {what}, this body has {expected}: it belongs to another body"
+            )))
+        }
+    }
+}
+
+impl SlaveState {
+    /// Appends the payload (layout in the module documentation) to `out`.
+    pub fn write_bytes(&self, out: &mut Vec<u8>) {
+        let mut w = Writer(out);
+        w.u32(PAYLOAD_FORMAT);
+        w.u32(self.inputs.len() as u32);
+        let p = &self.parameters;
+        w.f64s(&[
+            p.material.youngs_modulus,
+            p.material.poisson_ratio,
+            p.material.density,
+            p.damping_alpha,
+            p.damping_beta,
+        ]);
+        w.f64s(&p.gravity);
+        w.f64s(&p.initial_position);
+        w.f64s(&p.initial_rotation);
+        w.f64s(&p.initial_velocity);
+        w.f64s(&p.initial_angular_velocity);
+        w.f64s(&[p.step_size, p.rho_inf, p.tolerance]);
+        w.i32(p.max_iterations);
+        w.i32(p.formulation);
+        w.i32(p.stiffening);
+        w.i32(p.frames);
+        w.i32(p.anderson_depth);
+        w.u8(u8::from(p.nonlinear_forces));
+        self.inputs.iter().for_each(|i| w.f64s(i));
+        for d in &self.input_derivatives {
+            w.f64s(&d[0]);
+            w.f64s(&d[1]);
+        }
+        w.f64(self.start_time);
+        self.counters.iter().for_each(|&c| w.u64(c));
+        match &self.dynamics {
+            None => w.u8(0),
+            Some(d) => {
+                w.u8(1);
+                let s = &d.state;
+                w.f64(s.time);
+                w.u64(s.position.len() as u64);
+                w.f64s(&s.position);
+                w.f64s(&s.velocity);
+                w.f64s(&s.acceleration);
+                w.f64s(&s.pseudo_acceleration);
+                w.u64(s.multipliers.len() as u64);
+                w.f64s(&s.multipliers);
+                d.loads.iter().for_each(|l| w.f64s(l));
+                w.f64s(&d.gravity);
+            }
+        }
+    }
+}
+
+impl Slave {
+    /// Reads a payload written by [`SlaveState::write_bytes`] for this body; every count, number
+    /// and parameter is checked (see the module documentation).
+    pub fn state_from_bytes(&self, bytes: &[u8]) -> Result<SlaveState> {
+        let mut r = Reader { bytes, at: 0 };
+        let format = r.u32("the payload format")?;
+        if format != PAYLOAD_FORMAT {
+            return Err(Error::new(format!(
+                "the serialized FMU state has payload format {format}; this FMU reads format {PAYLOAD_FORMAT}"
+            )));
+        }
+        let n = r.u32("the interface count")? as usize;
+        if n != self.inputs.len() {
+            return Err(Error::new(format!(
+                "the serialized FMU state has {n} interfaces, this body has {}: it belongs to another body",
+                self.inputs.len()
+            )));
+        }
+        let mut p = self.defaults.clone();
+        let mut head = [0.0; 5];
+        r.f64s(&mut head, "material and damping parameters")?;
+        p.material = IsotropicMaterial {
+            youngs_modulus: head[0],
+            poisson_ratio: head[1],
+            density: head[2],
+        };
+        p.damping_alpha = head[3];
+        p.damping_beta = head[4];
+        r.f64s(&mut p.gravity, "gravity")?;
+        r.f64s(&mut p.initial_position, "initial.position")?;
+        r.f64s(&mut p.initial_rotation, "initial.rotation")?;
+        r.f64s(&mut p.initial_velocity, "initial.velocity")?;
+        r.f64s(&mut p.initial_angular_velocity, "initial.angularVelocity")?;
+        let mut solver = [0.0; 3];
+        r.f64s(&mut solver, "solver parameters")?;
+        [p.step_size, p.rho_inf, p.tolerance] = solver;
+        p.max_iterations = r.i32("solver.maxIterations")?;
+        p.formulation = r.i32("model.formulation")?;
+        p.stiffening = r.i32("model.stiffening")?;
+        p.frames = r.i32("model.frames")?;
+        p.anderson_depth = r.i32("solver.andersonDepth")?;
+        p.nonlinear_forces = match r.u8("model.nonlinearForces")? {
+            0 => false,
+            1 => true,
+            b => {
+                return Err(Error::new(format!(
+                    "the serialized FMU state holds {b} for model.nonlinearForces: not a Boolean"
+                )))
+            }
+        };
+        check_parameters(&p)?;
+        let mut inputs: Vec<Inputs> = vec![[0.0; 30]; n];
+        for i in &mut inputs {
+            r.f64s(i, "an input")?;
+        }
+        let mut input_derivatives: Vec<InputDerivatives> = vec![[[0.0; 30]; 2]; n];
+        for d in &mut input_derivatives {
+            r.f64s(&mut d[0], "an input derivative")?;
+            r.f64s(&mut d[1], "an input derivative")?;
+        }
+        let start_time = r.f64("the start time")?;
+        let counters = [
+            r.u64("the step counter")?,
+            r.u64("the iteration counter")?,
+            r.u64("the retry counter")?,
+        ];
+        let dynamics = match r.u8("the initialization flag")? {
+            0 => None,
+            1 => {
+                let time = r.f64("the time")?;
+                let n3 = 3 * self.mesh.node_count();
+                r.count(n3, "position coordinates")?;
+                let mut vectors = [vec![0.0; n3], vec![0.0; n3], vec![0.0; n3], vec![0.0; n3]];
+                for (v, what) in vectors.iter_mut().zip([
+                    "positions",
+                    "velocities",
+                    "accelerations",
+                    "pseudo-accelerations",
+                ]) {
+                    r.f64s(v, what)?;
+                }
+                let multipliers: usize = 3 * self
+                    .interfaces
+                    .iter()
+                    .map(|i| i.point_constraints.len())
+                    .sum::<usize>();
+                r.count(multipliers, "constraint multipliers")?;
+                let mut lambda = vec![0.0; multipliers];
+                r.f64s(&mut lambda, "the constraint multipliers")?;
+                let mut loads: Vec<Inputs> = vec![[0.0; 30]; n];
+                for l in &mut loads {
+                    r.f64s(l, "the loads of the state")?;
+                }
+                let mut gravity = [0.0; 3];
+                r.f64s(&mut gravity, "the gravity of the state")?;
+                let [position, velocity, acceleration, pseudo_acceleration] = vectors;
+                Some(Dynamics {
+                    state: DynamicState {
+                        time,
+                        position,
+                        velocity,
+                        acceleration,
+                        pseudo_acceleration,
+                        multipliers: lambda,
+                    },
+                    loads,
+                    gravity,
+                })
+            }
+            b => {
+                return Err(Error::new(format!(
+                    "the serialized FMU state holds {b} for the initialization flag: not 0 or 1"
+                )))
+            }
+        };
+        if r.at != bytes.len() {
+            return Err(Error::new(format!(
+                "the serialized FMU state has {} bytes after its end (byte {})",
+                bytes.len() - r.at,
+                r.at
+            )));
+        }
+        Ok(SlaveState {
+            parameters: p,
+            inputs,
+            input_derivatives,
+            start_time,
+            dynamics,
+            counters,
+        })
+    }
+}
+
+/// The parameter checks of `fmi2SetReal`/`fmi2SetInteger` for a deserialized set.
+fn check_parameters(p: &Parameters) -> Result<()> {
+    for (name, key, value) in [
+        (
+            "material.youngsModulus",
+            FixedKey::YoungsModulus,
+            p.material.youngs_modulus,
+        ),
+        (
+            "material.poissonRatio",
+            FixedKey::PoissonRatio,
+            p.material.poisson_ratio,
+        ),
+        ("material.density", FixedKey::Density, p.material.density),
+        ("damping.alpha", FixedKey::DampingAlpha, p.damping_alpha),
+        ("damping.beta", FixedKey::DampingBeta, p.damping_beta),
+        ("solver.stepSize", FixedKey::StepSize, p.step_size),
+        ("solver.rhoInf", FixedKey::RhoInf, p.rho_inf),
+        ("solver.tolerance", FixedKey::Tolerance, p.tolerance),
+    ] {
+        Parameters::check_real(name, key, value)
+            .map_err(|e| Error::new(format!("the serialized FMU state: {}", e.message)))?;
+    }
+    let bad = |name: &str, value: i32, why: &str| {
+        Err(Error::new(format!(
+            "the serialized FMU state: {name} = {value} rejected: {why}"
+        )))
+    };
+    if p.max_iterations < 1 {
+        return bad(
+            "solver.maxIterations",
+            p.max_iterations,
+            "must be at least 1",
+        );
+    }
+    if !(1..=2).contains(&p.formulation) {
+        return bad("model.formulation", p.formulation, "not 1 or 2");
+    }
+    if !(1..=3).contains(&p.stiffening) {
+        return bad("model.stiffening", p.stiffening, "not 1, 2 or 3");
+    }
+    if p.frames < 1 {
+        return bad("model.frames", p.frames, "must be at least 1");
+    }
+    if !(0..=crate::solver::anderson::MAX_DEPTH as i32).contains(&p.anderson_depth) {
+        return bad("solver.andersonDepth", p.anderson_depth, "not in [0, 8]");
+    }
+    Ok(())
+}

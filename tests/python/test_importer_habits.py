@@ -1,0 +1,151 @@
+"""Each importer's habits (FMI-IMPORTERS.md), replayed through fmpy's low-level FMU2Slave the way
+that importer calls the FMU: OMSimulator (four-slash resource URI, visible and logging on, start
+values before setupExperiment, no stop time, every status must be exactly fmi2OK, time accumulated
+as t += h, a tiny last step), the FMU Compliance Checker (inputs before setupExperiment, no
+tolerance and no stop time, all outputs read every step, overshooting last step, instance name
+copied, static version strings) and threads (ctypes releases the GIL: instances stepped at the same
+time from Python threads give the results they give alone)."""
+
+import ctypes
+import pathlib
+import threading
+
+import numpy as np
+import pytest
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import fmi2CoSimulation, fmi2Warning
+
+from flexbody_fmu import LOG, Instance
+
+H = 1e-3
+
+
+def status_checker():
+    """fmpy's fmiCallLogger: collects every call whose status is not fmi2OK (fmpy itself lets
+    fmi2Warning through; OMSimulator treats it as an error)."""
+    bad = []
+
+    def log(message):
+        # fmpy writes "fmi2DoStep(...) -> OK" for status-returning calls.
+        if " -> " in message and message.rsplit(" -> ", 1)[1].strip() in ("WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"):
+            bad.append(message)
+
+    return bad, log
+
+
+def test_omsimulator_habits_with_a_four_slash_resource_uri(driven_unzipdir, driven_model_description):
+    # The driven cantilever's GUID differs from the embedded default body's: if the four-slash
+    # URI were not understood, the FMU would fall back to the default body and refuse the GUID.
+    resources = pathlib.Path(driven_unzipdir, "resources").resolve()
+    uri = "file:///" + str(resources)  # fmi4c: "file:///" + absolute path -> file:////tmp/...
+    assert uri.startswith("file:////")
+    bad, call_logger = status_checker()
+    s = Instance(driven_unzipdir, driven_model_description, "oms", resource_location=uri, visible=True,
+                 call_logger=call_logger)
+    try:
+        # Start values (SSV) between instantiate and setupExperiment, in the Instantiated state.
+        s.set("damping.beta", 1e-3)
+        s.fmu.setupExperiment(tolerance=1e-6, startTime=0.0, stopTime=None)  # stopTimeDefined = false
+        s.fmu.enterInitializationMode()
+        s.set("root.velocity[2]", 0.0)
+        s.fmu.exitInitializationMode()
+        # The root frame moves up at 0.1 m/s; time accumulates as OMS does.
+        t = 0.0
+        outputs = [v for v in s.real_outputs]
+        for k in range(150):
+            s.set("root.position[2]", 0.1 * t)
+            s.set("root.velocity[2]", 0.1)
+            s.fmu.doStep(t, H, noSetFMUStatePriorToCurrentPoint=True)
+            t += H
+            values = np.array(s.fmu.getReal([s.vr[n] for n in outputs]))
+            assert np.all(np.isfinite(values))
+        # The last step clamped to the stop time: a tiny step.
+        s.fmu.doStep(t, 1e-12, noSetFMUStatePriorToCurrentPoint=True)
+        assert np.all(np.isfinite(s.outputs()))
+        assert s.get("tip.position[2]") == pytest.approx(0.1 * t, abs=2e-3)
+        s.fmu.terminate()
+        assert bad == [], bad
+        assert [r for r in s.messages() if r.status >= fmi2Warning] == []
+    finally:
+        s.fmu.freeInstance()
+
+
+def test_fmucheck_habits(unzipdir, model_description):
+    bad, call_logger = status_checker()
+    s = Instance(unzipdir, model_description, "Test FMI 2.0 CS", call_logger=call_logger)
+    try:
+        assert s.fmu.getTypesPlatform() == "default"
+        assert s.fmu.getVersion() == "2.0"
+        # Inputs from -i before setupExperiment, in the Instantiated state.
+        s.set("tip.force[2]", -10.0)
+        s.fmu.setupExperiment(tolerance=None, startTime=0.0, stopTime=None)
+        s.fmu.enterInitializationMode()
+        s.fmu.exitInitializationMode()
+        stop, h = 0.0255, 2e-3  # not a multiple of h: the last step overshoots
+        tcur = 0.0
+        refs = [s.vr[n] for n in s.real_outputs]
+        while tcur < stop:
+            s.fmu.doStep(tcur, h, noSetFMUStatePriorToCurrentPoint=True)
+            tcur += h
+            assert np.all(np.isfinite(s.fmu.getReal(refs)))
+        assert tcur > stop
+        assert s.get("tip.position[2]") < 0.0
+        s.fmu.terminate()
+        assert bad == [], bad
+        assert [r for r in s.messages() if r.status >= fmi2Warning] == []
+    finally:
+        s.fmu.freeInstance()
+
+
+def test_instance_name_guid_and_resource_location_are_copied(unzipdir, model_description):
+    # fmuCheck passes its own buffers and checks that the FMU copied them: here they are
+    # overwritten right after fmi2Instantiate; later messages still carry the original name.
+    s = Instance(unzipdir, model_description, "copy-probe")
+    try:
+        name = ctypes.create_string_buffer(b"copied name")
+        guid = ctypes.create_string_buffer(model_description.guid.encode())
+        location = ctypes.create_string_buffer(pathlib.Path(unzipdir, "resources").as_uri().encode())
+        component = s.fmu.fmi2Instantiate(name, fmi2CoSimulation, guid, location, ctypes.byref(s.fmu.callbacks), 0, 1)
+        assert component
+        for buffer in (name, guid, location):
+            ctypes.memset(buffer, ord("#"), len(buffer) - 1)
+        before = len(LOG)
+        # A rejected call makes the FMU log with the name it copied.
+        with pytest.raises(FMICallException):
+            s.fmu.fmi2DoStep(component, 0.0, H, 1)
+        new = LOG[before:]
+        assert new and all(r.instance_name == "copied name" for r in new), new
+        assert all(r.environment == s.environment for r in new)
+        s.fmu.fmi2FreeInstance(component)
+    finally:
+        s.free()
+
+
+def test_instances_stepped_from_python_threads_match_their_runs_alone(unzipdir, model_description):
+    loads = [-1.0, -2.0, -3.0, -4.0]
+
+    def run(k, barrier=None, results=None):
+        s = Instance(unzipdir, model_description, f"thread-{k}-{barrier is not None}")
+        try:
+            s.initialize({"tip.force[3]": loads[k], "damping.beta": 1e-4})
+            if barrier is not None:
+                barrier.wait()
+            rows = s.step(H, 40)
+        finally:
+            s.free()
+        if results is not None:
+            results[k] = rows
+        return rows
+
+    alone = [run(k) for k in range(len(loads))]
+    results = [None] * len(loads)
+    barrier = threading.Barrier(len(loads))
+    threads = [threading.Thread(target=run, args=(k, barrier, results)) for k in range(len(loads))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for k in range(len(loads)):
+        assert results[k] is not None, f"thread {k} failed"
+        assert results[k].tobytes() == alone[k].tobytes(), f"instance {k}"
+    assert len({r[-1].tobytes() for r in alone}) == len(loads)
