@@ -10,6 +10,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::mesh::{self, Mesh};
+use crate::model::body_file::Integrator;
 use crate::model::body_file::MeshSpec;
 use crate::model::model_description::{format_real, model_description, ModelInfo};
 use crate::model::variables::{
@@ -17,6 +18,7 @@ use crate::model::variables::{
 };
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
 use crate::solver::anderson::MAX_DEPTH;
+use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
 use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
@@ -41,6 +43,9 @@ const FORMULATION_FULL: i32 = 2;
 /// `model.stiffening` items.
 const STIFFENING_INERTIAL: i32 = 2;
 const STIFFENING_STRESS: i32 = 3;
+/// `solver.integrator` items.
+const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
+const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
 
 /// Most factorizations kept, one per internal step size in use, least recently used evicted.
 ///
@@ -92,6 +97,8 @@ pub struct Parameters {
     pub frames: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
+    /// `solver.integrator`: 1 generalized-α, 2 central difference.
+    pub integrator: i32,
 }
 
 impl Parameters {
@@ -118,12 +125,16 @@ impl Parameters {
             stiffening: 1,
             frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
             anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
+            integrator: match b.solver.integrator {
+                Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
+                Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
+            },
         }
     }
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
     /// placement, the step size and the iteration settings).
-    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, [i32; 3]) {
+    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, [i32; 4]) {
         (
             self.material,
             [
@@ -136,6 +147,7 @@ impl Parameters {
                 self.formulation * 16 + self.stiffening,
                 self.frames,
                 self.anderson_depth,
+                self.integrator,
             ],
         )
     }
@@ -181,7 +193,7 @@ struct Interface {
 
 /// The assembled model for one set of parameters.
 struct Model {
-    key: (IsotropicMaterial, [u64; 3], bool, [i32; 3]),
+    key: (IsotropicMaterial, [u64; 3], bool, [i32; 4]),
     body: Body,
     free: FreeNodes,
     scheme: GeneralizedAlpha,
@@ -192,6 +204,8 @@ struct Model {
     stiffening: Option<Stiffening>,
     /// The constant-mass solve for consistent accelerations (initialization, load jumps).
     mass: ConsistentAcceleration,
+    /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
+    explicit: Option<CentralDifference>,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -727,6 +741,13 @@ impl Slave {
                 Ok(())
             }
             Target::Fixed {
+                key: FixedKey::Integrator,
+                ..
+            } => {
+                self.parameters.integrator = value;
+                Ok(())
+            }
+            Target::Fixed {
                 key: FixedKey::AndersonDepth,
                 ..
             } => {
@@ -1026,9 +1047,12 @@ impl Slave {
                 &format!("does not match the FMU's time {t} (restore a state with fmi2SetFMUstate to go back)"),
             ));
         }
-        let substeps = ((big_h / self.parameters.step_size) * (1.0 - 1e-9))
-            .ceil()
-            .max(1.0);
+        // The explicit scheme's internal step is limited to its stable step.
+        let largest_step = match self.model.as_ref().and_then(|m| m.explicit.as_ref()) {
+            Some(explicit) => self.parameters.step_size.min(explicit.stable_step()),
+            None => self.parameters.step_size,
+        };
+        let substeps = ((big_h / largest_step) * (1.0 - 1e-9)).ceil().max(1.0);
         if substeps > 1e9 {
             return Err(Error::invalid_value(
                 "communicationStepSize",
@@ -1216,13 +1240,18 @@ impl Slave {
             } else {
                 tau0 + (j + 1) as f64 * hs
             });
-            let report = generalized_alpha::step(
-                &problem,
-                &mut model.matrices[index],
-                hs,
-                &mut dynamics.state,
-                &mut model.workspace,
-            )?;
+            let report = match &model.explicit {
+                Some(explicit) => {
+                    explicit.step(&problem, hs, &mut dynamics.state, &mut model.workspace)?
+                }
+                None => generalized_alpha::step(
+                    &problem,
+                    &mut model.matrices[index],
+                    hs,
+                    &mut dynamics.state,
+                    &mut model.workspace,
+                )?,
+            };
             self.statistics.0 += 1;
             self.statistics.1 += report.iterations as u64;
         }
@@ -1316,12 +1345,37 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
+        let explicit = if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
+            let lumped = fem::lumped_masses(&self.mesh, p.material.density);
+            let scheme = CentralDifference::new(&body, &lumped, &free)?;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
+                    scheme.highest_frequency,
+                    scheme.stable_step(),
+                    crate::solver::central_difference::STABILITY_MARGIN,
+                    if p.step_size > scheme.stable_step() {
+                        format!(
+                            "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
+                            p.step_size
+                        )
+                    } else {
+                        String::new()
+                    }
+                ),
+            });
+            Some(scheme)
+        } else {
+            None
+        };
         self.model = Some(Model {
             key,
             body,
             scheme: GeneralizedAlpha::new(p.rho_inf),
             matrices: Vec::new(),
             mass: ConsistentAcceleration::new(&free)?,
+            explicit,
             free,
             workspace,
             stiffening,
@@ -1336,6 +1390,9 @@ impl Slave {
         self.ensure_model()?;
         let p = &self.parameters;
         let model = self.model.as_mut().unwrap();
+        if model.explicit.is_some() {
+            return Ok(usize::MAX); // the explicit scheme factorises nothing
+        }
         if let Some(i) = model
             .matrices
             .iter()
@@ -1511,6 +1568,10 @@ impl Slave {
             &mut model.workspace,
             &mut model.mass,
         )?;
+        if let Some(explicit) = &model.explicit {
+            // The explicit scheme's accelerations belong to the lumped mass.
+            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.workspace);
+        }
         self.dynamics = Some(Dynamics {
             state,
             loads: self.inputs.clone(),
@@ -1880,6 +1941,7 @@ fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
         FixedKey::Stiffening => Some(p.stiffening),
         FixedKey::Frames => Some(p.frames),
         FixedKey::AndersonDepth => Some(p.anderson_depth),
+        FixedKey::Integrator => Some(p.integrator),
         _ => None,
     }
 }

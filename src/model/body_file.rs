@@ -119,6 +119,20 @@ pub struct SolverSpec {
     /// History of Anderson's acceleration of the fixed-point iteration (0: plain; at most 8).
     #[serde(default = "SolverSpec::default_anderson_depth")]
     pub anderson_depth: u32,
+    /// Time integration scheme.
+    #[serde(default)]
+    pub integrator: Integrator,
+}
+
+/// The time integration scheme (`solver.integrator`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub enum Integrator {
+    /// Implicit generalized-α (Arnold–Brüls): one constant factorization per step size.
+    #[default]
+    GeneralizedAlpha,
+    /// Explicit central difference with the lumped mass, the step limited by `2/ω_max`.
+    CentralDifference,
 }
 
 impl SolverSpec {
@@ -147,6 +161,7 @@ impl Default for SolverSpec {
             tolerance: Self::default_tolerance(),
             max_iterations: Self::default_max_iterations(),
             anderson_depth: Self::default_anderson_depth(),
+            integrator: Integrator::default(),
         }
     }
 }

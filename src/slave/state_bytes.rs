@@ -7,7 +7,7 @@
 //! | --- | --- |
 //! | payload format | u32 = [`PAYLOAD_FORMAT`] |
 //! | interfaces `n` | u32 |
-//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth: i32; nonlinear forces: u8 |
+//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator: i32; nonlinear forces: u8 |
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | start time | f64 |
@@ -136,6 +136,7 @@ impl SlaveState {
         w.i32(p.stiffening);
         w.i32(p.frames);
         w.i32(p.anderson_depth);
+        w.i32(p.integrator);
         w.u8(u8::from(p.nonlinear_forces));
         self.inputs.iter().for_each(|i| w.f64s(i));
         for d in &self.input_derivatives {
@@ -205,6 +206,7 @@ impl Slave {
         p.stiffening = r.i32("model.stiffening")?;
         p.frames = r.i32("model.frames")?;
         p.anderson_depth = r.i32("solver.andersonDepth")?;
+        p.integrator = r.i32("solver.integrator")?;
         p.nonlinear_forces = match r.u8("model.nonlinearForces")? {
             0 => false,
             1 => true,
@@ -337,6 +339,9 @@ fn check_parameters(p: &Parameters) -> Result<()> {
     }
     if !(1..=3).contains(&p.stiffening) {
         return bad("model.stiffening", p.stiffening, "not 1, 2 or 3");
+    }
+    if !(1..=2).contains(&p.integrator) {
+        return bad("solver.integrator", p.integrator, "not 1 or 2");
     }
     if p.frames < 1 {
         return bad("model.frames", p.frames, "must be at least 1");

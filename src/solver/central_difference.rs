@@ -111,18 +111,20 @@ impl CentralDifference {
     /// `a = M_L⁻¹ (f_ext − f(x, v))` (the start of a run, or after the inputs changed).
     pub fn accelerations(
         &self,
-        problem: &StepProblem,
+        body: &Body,
+        free: &FreeNodes,
+        loads: &dyn Fn(&[f64], &mut [f64]),
         state: &mut DynamicState,
         ws: &mut StepWorkspace,
     ) {
-        for &i in &problem.free.nodes {
+        for &i in &free.nodes {
             state.acceleration[3 * i..3 * i + 3].fill(0.0);
         }
         // The residual at zero free acceleration is f(x, v) − f_ext (+ the clamped nodes'
         // inertia coupling).
-        residual(problem.body, problem.free, state, problem.loads, ws);
+        residual(body, free, state, loads, ws);
         let r = super::generalized_alpha::last_residual(ws);
-        for &i in &problem.free.nodes {
+        for &i in &free.nodes {
             let w = self.inverse_mass[i];
             let nodal = &r[3 * i..3 * i + 3];
             for (a, r) in state.acceleration[3 * i..3 * i + 3].iter_mut().zip(nodal) {
