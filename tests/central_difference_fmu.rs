@@ -20,7 +20,7 @@ fn response(settings: &[(&str, f64)]) -> (Vec<f64>, flexbody::slave::Slave) {
 #[test]
 fn central_difference_limits_its_step_and_agrees_with_generalized_alpha() {
     let (explicit, mut s) = response(&[("solver.integrator", 2.0), ("solver.stepSize", 1e-3)]);
-    let messages: Vec<String> = s.drain_events().into_iter().map(|e| e.message).collect();
+    let messages: Vec<String> = s.drain_events().map(|e| e.message).collect();
     let note = messages
         .iter()
         .find(|m| m.contains("central difference"))
