@@ -20,7 +20,7 @@
 //!
 //! Models: `reducedStrain` with `f_nl` off (the default) and on, and `full`. Prints Markdown
 //! tables; with `--csv FILE` also writes one row per run:
-//! `problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error`.
+//! `problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error` (model quoted).
 
 use flexbody::model::{BodyFile, VariableType};
 use flexbody::slave::Slave;
@@ -192,7 +192,7 @@ fn main() {
             );
             writeln!(
                 csv,
-                "B1,{label},{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
+                "B1,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
                 steps as f64 / wall,
                 error / peak
             )
@@ -236,7 +236,7 @@ fn main() {
                     );
                     writeln!(
                         csv,
-                        "B3,{label},{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
+                        "B3,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
                         steps as f64 / wall,
                         error / peak
                     )
