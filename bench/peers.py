@@ -235,7 +235,7 @@ def main():
         steps = int(round(end / h))
         err = error_against(reference, t, y)
         print(
-            f"| {label_long} | {h:g} | {end:g} | {steps} | {1e3 * wall:.1f} | {steps / wall:.0f} "
+            f"| {label_long} | {h:g} | {end:g} | {steps} | {1e3 * wall:.1f} | {steps / wall:.3g} "
             f"| {err:.3e} | {err / peak:.2e} |",
             flush=True,
         )

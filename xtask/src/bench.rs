@@ -90,6 +90,7 @@ pub fn bench_task(workspace: &Workspace, quick: bool) -> Result<()> {
     // The bench venv first: a broken install should fail before half an hour of measurements.
     let python = venv::ensure_env(workspace, &venv::BENCH)?;
 
+    let root = workspace.root.display().to_string();
     let mut sections = String::new();
     for (k, entry) in SUITE.iter().enumerate() {
         progress(
@@ -118,7 +119,7 @@ pub fn bench_task(workspace: &Workspace, quick: bool) -> Result<()> {
             entry.example,
             args.join(" ")
                 .replace(&workspace.root.display().to_string(), "."),
-            table.trim_end()
+            table.trim_end().replace(&root, ".")
         )
         .unwrap();
     }
@@ -160,7 +161,7 @@ pub fn bench_task(workspace: &Workspace, quick: bool) -> Result<()> {
         sections,
         "## Peers: Exudyn on B1, our mesh and matrices\n\n{}\n`bench/peers.py{}` ({seconds:.0} s; \
          the models and their settings are described in the script's docstring)\n\n{}\n",
-        exported.trim_end(),
+        exported.trim_end().replace(&root, "."),
         if quick { " --quick" } else { "" },
         peers.trim_end()
     )
