@@ -4,20 +4,33 @@
 //! The suite (each an example that prints Markdown tables, see its own doc comment):
 //! * `step_cost`: the cost of one step against its floor, one pair of triangular solves;
 //! * `b3_table`: B3 through the slave for every model choice, `full` as the yardstick (issue 4);
-//! * `b2_drift`: B2's angular momentum and energy drift with and without `f_nl` and frames.
+//! * `b2_drift`: B2's angular momentum and energy drift with and without `f_nl` and frames;
+//! * `work_precision`: run time against error on B1 and B3 for each formulation (CSV);
+//! * `step_scaling`: a step against one solve from 384 to ~100k DOF (CSV);
+//! * the peers: `export_matrices` writes B1's mesh and matrices, `bench/peers.py` runs Exudyn's
+//!   floating frame of reference on them (CB-8 modes and all nodal DOF) in the pinned bench venv
+//!   (`<target>/bench-venv` from `bench/requirements.txt` + `constraints.txt`), against
+//!   `work_precision`'s B1 reference trajectory (CSV);
+//! * `bench/plot.py`: the PNGs (work–precision, step scaling) and the summary of ratios at equal
+//!   error, which heads the report.
 //!
-//! `--quick` runs fewer steps (for checking the task itself; its figures are not for reports).
+//! CSVs and PNGs go beside the report as `bench/results/<date>[-quick]-<name>.{csv,png}`.
+//! `--quick` runs fewer steps and sizes (for checking the task itself; its figures are not for
+//! reports).
 
-use crate::{output, Result, Workspace};
+use crate::{output, venv, Result, Workspace};
 use std::fmt::Write as _;
+use std::path::Path;
 use std::time::{Instant, SystemTime, UNIX_EPOCH};
 
-/// One entry of the suite: title, example and its arguments (full and quick).
+/// One entry of the suite: title, example and its arguments (full and quick); `csv`: the example
+/// takes `--csv FILE` and writes `<date>-<csv>.csv` beside the report.
 struct Entry {
     title: &'static str,
     example: &'static str,
     args: &'static [&'static str],
     quick_args: &'static [&'static str],
+    csv: Option<&'static str>,
 }
 
 const SUITE: &[Entry] = &[
@@ -26,83 +39,180 @@ const SUITE: &[Entry] = &[
         example: "step_cost",
         args: &["2000"],
         quick_args: &["50"],
+        csv: None,
     },
     Entry {
         title: "B3: every model choice against the full nonlinear reference",
         example: "b3_table",
         args: &["0.01"],
         quick_args: &["0.01", "40 frames"],
+        csv: None,
     },
     Entry {
         title: "B2: angular momentum and energy drift of a free tumbling beam over 10 s",
         example: "b2_drift",
         args: &["1e-3"],
         quick_args: &["2e-3"],
+        csv: None,
+    },
+    Entry {
+        title: "Run time against error: B1 dynamic and B3, every formulation",
+        example: "work_precision",
+        args: &[],
+        quick_args: &["--quick"],
+        csv: Some("work_precision"),
+    },
+    Entry {
+        title: "Per-step cost against the floor, 384 to ~100k DOF",
+        example: "step_scaling",
+        args: &[],
+        quick_args: &["--quick"],
+        csv: Some("step_scaling"),
     },
 ];
 
+/// Steps after the examples: the matrix export, the peers, the plots.
+const EXTRA_STEPS: usize = 3;
+
 pub fn bench_task(workspace: &Workspace, quick: bool) -> Result<()> {
-    let mut report = String::new();
     let date = utc_date();
-    writeln!(report, "# Benchmarks, {date}\n").unwrap();
-    writeln!(report, "{}", machine(workspace)).unwrap();
-    if quick {
-        writeln!(report, "**--quick run: reduced sizes, not for reports.**\n").unwrap();
-    }
+    let dir = workspace.root.join("bench").join("results");
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let stem = if quick {
+        format!("{date}-quick")
+    } else {
+        date.clone()
+    };
+    let file = |name: &str| dir.join(format!("{stem}-{name}"));
+    let total = SUITE.len() + EXTRA_STEPS;
+    let progress = |k: usize, what: &str| println!("xtask bench: [{k}/{total}] {what}");
+
+    // The bench venv first: a broken install should fail before half an hour of measurements.
+    let python = venv::ensure_env(workspace, &venv::BENCH)?;
+
+    let root = workspace.root.display().to_string();
+    let mut sections = String::new();
     for (k, entry) in SUITE.iter().enumerate() {
-        println!(
-            "xtask bench: [{}/{}] {} (cargo run --release --example {})",
+        progress(
             k + 1,
-            SUITE.len(),
-            entry.title,
-            entry.example
+            &format!(
+                "{} (cargo run --release --example {})",
+                entry.title, entry.example
+            ),
         );
         let started = Instant::now();
-        let args = if quick { entry.quick_args } else { entry.args };
-        let table = output(
-            workspace
-                .cargo()
-                .args([
-                    "run",
-                    "--quiet",
-                    "--release",
-                    "--example",
-                    entry.example,
-                    "--",
-                ])
-                .args(args),
-        )?;
+        let mut args: Vec<String> = if quick { entry.quick_args } else { entry.args }
+            .iter()
+            .map(|a| a.to_string())
+            .collect();
+        if let Some(name) = entry.csv {
+            args.push("--csv".into());
+            args.push(file(&format!("{name}.csv")).display().to_string());
+        }
+        let table = run_example(workspace, entry.example, &args)?;
         let seconds = started.elapsed().as_secs_f64();
-        println!(
-            "xtask bench: [{}/{}] done in {seconds:.0} s",
-            k + 1,
-            SUITE.len()
-        );
+        println!("xtask bench: [{}/{total}] done in {seconds:.0} s", k + 1);
         writeln!(
-            report,
+            sections,
             "## {}\n\n`cargo run --release --example {} -- {}` ({seconds:.0} s)\n\n{}\n",
             entry.title,
             entry.example,
-            args.join(" "),
-            table.trim_end()
+            args.join(" ")
+                .replace(&workspace.root.display().to_string(), "."),
+            table.trim_end().replace(&root, ".")
         )
         .unwrap();
     }
-    let dir = workspace.root.join("bench").join("results");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let name = if quick {
-        format!("{date}-quick.md")
-    } else {
-        format!("{date}.md")
-    };
-    let path = dir.join(name);
+
+    // The peers: B1's mesh and matrices for Exudyn, then bench/peers.py against our reference.
+    let mut k = SUITE.len() + 1;
+    progress(k, "B1's mesh and matrices for the peers (export_matrices)");
+    let matrices = workspace.target_dir.join("bench").join("b1-matrices");
+    let exported = run_example(
+        workspace,
+        "export_matrices",
+        &[matrices.display().to_string()],
+    )?;
+    k += 1;
+    progress(
+        k,
+        "peers: Exudyn's floating frame of reference on B1 (bench/peers.py)",
+    );
+    let started = Instant::now();
+    let reference = file("work_precision_b1_reference.csv");
+    let peers_csv = file("peers.csv");
+    let mut command = std::process::Command::new(&python);
+    command
+        .arg(workspace.root.join("bench/peers.py"))
+        .arg("--matrices")
+        .arg(&matrices)
+        .arg("--reference")
+        .arg(&reference)
+        .arg("--csv")
+        .arg(&peers_csv)
+        .env("PYTHONWARNINGS", "ignore::DeprecationWarning");
+    if quick {
+        command.arg("--quick");
+    }
+    let peers = output(&mut command)?;
+    let seconds = started.elapsed().as_secs_f64();
+    println!("xtask bench: [{k}/{total}] done in {seconds:.0} s");
+    writeln!(
+        sections,
+        "## Peers: Exudyn on B1, our mesh and matrices\n\n{}\n`bench/peers.py{}` ({seconds:.0} s; \
+         the models and their settings are described in the script's docstring)\n\n{}\n",
+        exported.trim_end().replace(&root, "."),
+        if quick { " --quick" } else { "" },
+        peers.trim_end()
+    )
+    .unwrap();
+
+    k += 1;
+    progress(k, "plots and summary (bench/plot.py)");
+    let summary = output(
+        std::process::Command::new(&python)
+            .arg(workspace.root.join("bench/plot.py"))
+            .arg("--prefix")
+            .arg(dir.join(&stem))
+            .arg("--work")
+            .arg(file("work_precision.csv"))
+            .arg("--peers")
+            .arg(&peers_csv)
+            .arg("--scaling")
+            .arg(file("step_scaling.csv")),
+    )?;
+
+    let mut report = String::new();
+    writeln!(report, "# Benchmarks, {date}\n").unwrap();
+    writeln!(report, "{}", machine(workspace, &python)).unwrap();
+    if quick {
+        writeln!(report, "**--quick run: reduced sizes, not for reports.**\n").unwrap();
+    }
+    writeln!(
+        report,
+        "## Summary: ours against the peers\n\n{}\n\nData: `{stem}-*.csv` beside this file.\n",
+        summary.trim_end()
+    )
+    .unwrap();
+    report.push_str(&sections);
+    let path = dir.join(format!("{stem}.md"));
     std::fs::write(&path, report).map_err(|e| format!("{}: {e}", path.display()))?;
     println!("xtask bench: wrote {}", path.display());
     Ok(())
 }
 
-/// Machine, compiler and source revision, as a Markdown list.
-fn machine(workspace: &Workspace) -> String {
+/// `cargo run --quiet --release --example <example> -- <args>`, its standard output.
+fn run_example(workspace: &Workspace, example: &str, args: &[String]) -> Result<String> {
+    output(
+        workspace
+            .cargo()
+            .args(["run", "--quiet", "--release", "--example", example, "--"])
+            .args(args),
+    )
+}
+
+/// Machine, compiler, Python and Exudyn, and the source revision, as a Markdown list.
+fn machine(workspace: &Workspace, python: &Path) -> String {
     let read = |command: &mut std::process::Command| {
         output(command)
             .map(|s| s.trim().to_string())
@@ -119,8 +229,15 @@ fn machine(workspace: &Workspace) -> String {
         .unwrap_or_else(|| "unknown".into());
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     format!(
-        "- machine: {cpu}, {cores} cores available (shared: medians, compare ratios within one run)\n- {}\n- source: {}\n",
+        "- machine: {cpu}, {cores} cores available (shared: medians, compare ratios within one run)\n- {}\n- {}, Exudyn {} (bench venv: `bench/requirements.txt`)\n- source: {}\n",
         read(std::process::Command::new("rustc").arg("-V")),
+        read(std::process::Command::new(python).arg("--version")),
+        read(std::process::Command::new(python).args([
+            "-W",
+            "ignore",
+            "-c",
+            "import exudyn; print(exudyn.config.Version())"
+        ])),
         read(workspace.git().args(["describe", "--always", "--dirty"]))
     )
 }

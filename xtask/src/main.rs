@@ -10,8 +10,9 @@
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
-//! * `bench [--quick]`: the measurement examples in release mode, their tables written to
-//!   `bench/results/<date>.md` (see `bench.rs`).
+//! * `bench [--quick]`: the measurement examples in release mode, the Exudyn peers in the pinned
+//!   bench venv (`<target>/bench-venv`) and the plots, written to `bench/results/<date>.md`
+//!   (see `bench.rs`).
 //! * `venv`: only the pinned Python environment; prints its interpreter.
 //!
 //! Only `std::process::Command` and the zip crate: no shell, no build scripts of our own.
@@ -40,8 +41,9 @@ tasks:
   demo                              simulate the default cantilever with fmpy, print a table,
                                     compare with the Timoshenko deflection, plot to
                                     <target>/demo/cantilever.png
-  bench [--quick]                   run the measurement examples in release mode and write
-                                    their tables to bench/results/<date>.md
+  bench [--quick]                   run the measurement examples in release mode, the Exudyn
+                                    peers (pinned venv <target>/bench-venv) and the plots;
+                                    report in bench/results/<date>.md
   venv                              set up the pinned venv only and print its python";
 
 fn main() -> ExitCode {

@@ -1,6 +1,8 @@
-//! The pinned Python environment of the fmpy tests and the demo: `<target>/venv`, made with
-//! `python3 -m venv` and filled from `tests/python/requirements.txt` with every transitive
-//! dependency pinned by `tests/python/constraints.txt`.
+//! The pinned Python environments, made with `python3 -m venv` and filled from a
+//! `requirements.txt` with every transitive dependency pinned by the `constraints.txt` beside it:
+//! * [`TESTS`]: `<target>/venv` from `tests/python/` (the fmpy tests and the demo, CI);
+//! * [`BENCH`]: `<target>/bench-venv` from `bench/` (Exudyn, scipy, matplotlib for
+//!   `cargo xtask bench`; kept apart so that the test venv stays small).
 //!
 //! A stamp file in the venv holds the interpreter's version and both files' text; the venv is
 //! reused while the stamp matches and rebuilt from scratch when it does not (or when an
@@ -12,16 +14,40 @@ use std::process::Command;
 
 const STAMP: &str = "flexbody-requirements.stamp";
 
+/// A pinned environment: the folder (relative to the workspace root) that holds its
+/// `requirements.txt` and `constraints.txt`, and the venv's folder name under the target dir.
+pub struct Env {
+    pub files: &'static str,
+    pub venv: &'static str,
+}
+
+/// The fmpy tests and the demo.
+pub const TESTS: Env = Env {
+    files: "tests/python",
+    venv: "venv",
+};
+
+/// The benchmark's peers and plots.
+pub const BENCH: Env = Env {
+    files: "bench",
+    venv: "bench-venv",
+};
+
+/// The test venv's Python interpreter (see [`ensure_env`]).
+pub fn ensure(workspace: &Workspace) -> Result<PathBuf> {
+    ensure_env(workspace, &TESTS)
+}
+
 /// Returns the venv's Python interpreter, creating or rebuilding the venv when needed.
 /// The base interpreter is `$FLEXBODY_PYTHON`, else `python3`.
-pub fn ensure(workspace: &Workspace) -> Result<PathBuf> {
+pub fn ensure_env(workspace: &Workspace, env: &Env) -> Result<PathBuf> {
     let base_python = std::env::var_os("FLEXBODY_PYTHON").unwrap_or_else(|| "python3".into());
-    let requirements = workspace.root.join("tests/python/requirements.txt");
-    let constraints = workspace.root.join("tests/python/constraints.txt");
+    let requirements = workspace.root.join(env.files).join("requirements.txt");
+    let constraints = workspace.root.join(env.files).join("constraints.txt");
     let version = crate::output(Command::new(&base_python).arg("--version"))?;
     let wanted = stamp_text(&version, &read(&requirements)?, &read(&constraints)?);
 
-    let venv = workspace.target_dir.join("venv");
+    let venv = workspace.target_dir.join(env.venv);
     let python = venv_python(&venv);
     let stamp = venv.join(STAMP);
     if python.exists() && std::fs::read_to_string(&stamp).ok().as_deref() == Some(wanted.as_str()) {
@@ -100,7 +126,17 @@ mod tests {
     #[test]
     fn pinned_files_pin_every_line() {
         // Every requirement is `name==version`: an unpinned line would make the venv drift.
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/python");
+        for env in [TESTS, BENCH] {
+            let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("..")
+                .join(env.files);
+            pinned(&dir);
+            let requirements = read(&dir.join("requirements.txt")).unwrap();
+            assert!(requirements.lines().any(|l| l.trim() == "fmpy==0.3.32"));
+        }
+    }
+
+    fn pinned(dir: &Path) {
         for file in ["requirements.txt", "constraints.txt"] {
             let text = read(&dir.join(file)).unwrap();
             let lines: Vec<&str> = text
@@ -119,7 +155,5 @@ mod tests {
                 );
             }
         }
-        let requirements = read(&dir.join("requirements.txt")).unwrap();
-        assert!(requirements.lines().any(|l| l.trim() == "fmpy==0.3.32"));
     }
 }
