@@ -5,6 +5,7 @@
 use crate::body::frame::{nearest_rotation, node, set_node};
 use crate::body::interface::{DrivingFrame, InterfaceMotion};
 use crate::body::stiffening::Stiffening;
+use crate::body::strain_monitor::{StrainMonitor, DEFAULT_THRESHOLD};
 use crate::body::{Body, BodyOptions, NodeSet, Patches};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
@@ -206,6 +207,8 @@ struct Model {
     mass: ConsistentAcceleration,
     /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
     explicit: Option<CentralDifference>,
+    /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
+    strain_monitor: Option<(StrainMonitor, bool)>,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -1111,6 +1114,32 @@ impl Slave {
                 }
                 dynamics.gravity = self.parameters.gravity;
                 self.outputs.valid = false;
+                // The small-strain watch: a message when ‖∇ū‖ crosses the threshold (once per
+                // crossing; again after it fell below half of it).
+                let model = self.model.as_mut().expect("the model exists after a step");
+                if let Some((monitor, above)) = &mut model.strain_monitor {
+                    let g = monitor
+                        .largest_gradient(model.workspace.force_scratch().local_deformation());
+                    if g > DEFAULT_THRESHOLD && !*above {
+                        *above = true;
+                        self.events.push(LogEvent {
+                            category: "logEvents",
+                            message: format!(
+                                "warning: at t = {} the deformation gradient in the co-moving frame reached ‖∇ū‖ ≈ {g:.3} (> {DEFAULT_THRESHOLD}): beyond the small-strain range of the reduced strain the results lose accuracy without other signs; use model.frames > 1 for large bending or model.formulation = full",
+                                current_communication_point + big_h
+                            ),
+                        });
+                    } else if g < 0.5 * DEFAULT_THRESHOLD && *above {
+                        *above = false;
+                        self.events.push(LogEvent {
+                            category: "logEvents",
+                            message: format!(
+                                "at t = {} ‖∇ū‖ ≈ {g:.3} is back within the small-strain range",
+                                current_communication_point + big_h
+                            ),
+                        });
+                    }
+                }
                 Ok(())
             }
             Err(e) => {
@@ -1376,6 +1405,8 @@ impl Slave {
             matrices: Vec::new(),
             mass: ConsistentAcceleration::new(&free)?,
             explicit,
+            strain_monitor: (p.formulation != FORMULATION_FULL && p.frames == 1)
+                .then(|| (StrainMonitor::new(&self.mesh), false)),
             free,
             workspace,
             stiffening,

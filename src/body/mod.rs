@@ -6,6 +6,7 @@ pub mod frame;
 pub mod interface;
 pub mod patches;
 pub mod stiffening;
+pub mod strain_monitor;
 
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;

@@ -377,6 +377,11 @@ pub struct StepWorkspace {
 }
 
 impl StepWorkspace {
+    /// The body's force scratch: `ū`, `g` of the last residual.
+    pub fn force_scratch(&self) -> &ForceScratch {
+        &self.force_scratch
+    }
+
     pub fn new(body: &Body, free: &FreeNodes) -> StepWorkspace {
         Self::with_anderson_depth(body, free, DEFAULT_ANDERSON_DEPTH)
     }
