@@ -120,7 +120,8 @@ fn a_thin_slender_section_follows_the_square_one() {
     // rectangle 77.46 mm (in the plane of rotation) × 5.164 mm with the same EI and ρA as the
     // 0.1 m square of the primary version: beam theory predicts the same in-plane response.
     // Elements 250 mm × 77 mm × 5 mm (aspect ratio 48) test the conditioning; shear and the
-X
+    // section's own inertia differ by < 1e-3. Measured: 0.06 % of the peak apart; the 2 % bound
+    // leaves room for the hex20 discretisation of the two sections.
     let square = example_body("hub_beam");
     let mut thin = square.clone();
     let flexbody::model::body_file::MeshSpec::Beam { width, height, .. } = &mut thin.mesh;
