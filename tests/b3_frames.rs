@@ -12,10 +12,8 @@
 //! the peak (t ≤ 7.5 s).
 
 mod common;
-use common::b3::hub;
 use common::*;
 use flexbody::model::body_file::MeshSpec;
-use nalgebra::{Rotation3, Vector3};
 
 const H: f64 = 1e-2;
 const END: f64 = 7.5;
@@ -28,21 +26,7 @@ fn run(settings: &[(&str, f64)]) -> (Vec<f64>, f64) {
     let mut s = initialized(body, settings);
     let mut history = Vec::new();
     for k in 0..(END / H).round() as usize {
-        let t = k as f64 * H;
-        let (theta, rate) = hub(t);
-        let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), theta).matrix();
-        for c in 0..9 {
-            set(
-                &mut s,
-                &format!("hub.rotation[{}]", c + 1),
-                q[(c / 3, c % 3)],
-            );
-        }
-        set(&mut s, "hub.angularVelocity[3]", rate);
-        s.do_step(t, H).unwrap();
-        let q1 = Rotation3::from_axis_angle(&Vector3::z_axis(), hub(t + H).0);
-        let tip = Vector3::from_fn(|c, _| get(&mut s, &format!("tip.position[{}]", c + 1)));
-        history.push((q1.inverse() * tip).y);
+        history.push(b3_step(&mut s, k as f64 * H, H));
     }
     let (steps, iterations) = s.solver_statistics();
     (history, iterations as f64 / steps as f64)

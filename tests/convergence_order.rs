@@ -31,15 +31,17 @@ struct Cantilever {
     tip: Vec<usize>,
 }
 
-fn cantilever() -> Cantilever {
-    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex20).unwrap();
+/// The cantilever with 10×1×1 elements of `kind`, and its HRZ-lumped masses.
+fn cantilever_of(kind: ElementKind) -> (Cantilever, Vec<f64>) {
+    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], kind).unwrap();
     let material = IsotropicMaterial::STEEL;
     let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+    let lumped = fem::lumped_masses(&mesh, material.density);
     let body = Body::new(
         reference,
         fem::scalar_mass_matrix(&mesh, material.density),
         fem::stiffness_matrix(&mesh, &material),
-        fem::lumped_masses(&mesh, material.density),
+        lumped.clone(),
         BodyOptions::default(),
     );
     let clamped: Vec<bool> = mesh.nodes().iter().map(|p| p[0].abs() < 1e-9).collect();
@@ -47,7 +49,11 @@ fn cantilever() -> Cantilever {
         .filter(|&i| (mesh.nodes()[i][0] - 1.0).abs() < 1e-9)
         .collect();
     let free = FreeNodes::new(&body, &clamped);
-    Cantilever { body, free, tip }
+    (Cantilever { body, free, tip }, lumped)
+}
+
+fn cantilever() -> Cantilever {
+    cantilever_of(ElementKind::Hex20).0
 }
 
 fn load(c: &Cantilever, t: f64) -> impl Fn(&[f64], &mut [f64]) + '_ {
@@ -179,33 +185,10 @@ fn a_load_jump_restarts_from_consistent_accelerations() {
     assert_eq!(state.acceleration, state.pseudo_acceleration);
 }
 
-/// The hex8 version of the cantilever (cheap: the explicit scheme takes ~1e4 steps here).
-fn coarse_cantilever() -> Cantilever {
-    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex8).unwrap();
-    let material = IsotropicMaterial::STEEL;
-    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
-    let body = Body::new(
-        reference,
-        fem::scalar_mass_matrix(&mesh, material.density),
-        fem::stiffness_matrix(&mesh, &material),
-        fem::lumped_masses(&mesh, material.density),
-        BodyOptions::default(),
-    );
-    let clamped: Vec<bool> = mesh.nodes().iter().map(|p| p[0].abs() < 1e-9).collect();
-    let tip = (0..mesh.node_count())
-        .filter(|&i| (mesh.nodes()[i][0] - 1.0).abs() < 1e-9)
-        .collect();
-    let free = FreeNodes::new(&body, &clamped);
-    Cantilever { body, free, tip }
-}
-
 #[test]
 fn central_difference_critical_step_matches_the_highest_eigenvalue() {
-    let c = coarse_cantilever();
-    let lumped = {
-        let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex8).unwrap();
-        fem::lumped_masses(&mesh, IsotropicMaterial::STEEL.density)
-    };
+    // The hex8 mesh: the explicit scheme takes ~1e4 steps here.
+    let (c, lumped) = cantilever_of(ElementKind::Hex8);
     let scheme = CentralDifference::new(&c.body, &lumped, &c.free).unwrap();
     // Dense ω_max² = λ_max(M_L^{-1/2} K_FF M_L^{-1/2}).
     let dofs: Vec<usize> = c
@@ -263,9 +246,7 @@ fn run_explicit(c: &Cantilever, scheme: &CentralDifference, h: f64) -> Vec<f64> 
 
 #[test]
 fn central_difference_is_second_order_and_refuses_an_unstable_step() {
-    let c = coarse_cantilever();
-    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex8).unwrap();
-    let lumped = fem::lumped_masses(&mesh, IsotropicMaterial::STEEL.density);
+    let (c, lumped) = cantilever_of(ElementKind::Hex8);
     let scheme = CentralDifference::new(&c.body, &lumped, &c.free).unwrap();
     // Steps that divide 1 ms, the largest below the stable step.
     let base = 1e-3 / (1e-3 / scheme.stable_step()).ceil();

@@ -55,3 +55,23 @@ pub fn initialized(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
 pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     initialized(BodyFile::default_body(), settings)
 }
+
+/// One B3 step: the hub's rotation and rate of the schedule at `t` as inputs of the motion
+/// interface `hub`, a step of `h`, and the tip deflection in the hub frame at `t + h` (m).
+pub fn b3_step(slave: &mut Slave, t: f64, h: f64) -> f64 {
+    use nalgebra::{Rotation3, Vector3};
+    let (theta, rate) = b3::hub(t);
+    let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), theta).matrix();
+    for c in 0..9 {
+        set(
+            slave,
+            &format!("hub.rotation[{}]", c + 1),
+            q[(c / 3, c % 3)],
+        );
+    }
+    set(slave, "hub.angularVelocity[3]", rate);
+    slave.do_step(t, h).unwrap();
+    let q1 = Rotation3::from_axis_angle(&Vector3::z_axis(), b3::hub(t + h).0);
+    let tip = Vector3::from_fn(|c, _| get(slave, &format!("tip.position[{}]", c + 1)));
+    (q1.inverse() * tip).y
+}
