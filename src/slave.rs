@@ -9,8 +9,7 @@ use crate::body::{Body, BodyOptions, NodeSet};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
-use crate::mesh::{self, Mesh};
-use crate::model::body_file::MeshSpec;
+use crate::mesh::Mesh;
 use crate::model::model_description::{format_real, model_description, ModelInfo};
 use crate::model::variables::{
     EnumerationSpec, FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT,
@@ -230,21 +229,29 @@ impl Slave {
             }
             _ => BodyFile::default_body(),
         };
-        Slave::from_body(body)
+        Slave::from_body_in(body, resource_dir)
     }
 
-    /// A fresh instance of `body_file` (parameters at their start values, Instantiated).
+    /// Reads the body file at `path` (a mesh file it names is looked up beside it).
+    pub fn from_body_path(path: &Path) -> Result<Slave> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::new(format!("cannot read the body file {}: {e}", path.display()))
+        })?;
+        let body = BodyFile::from_json(&text)
+            .map_err(|e| Error::new(format!("{}: {}", path.display(), e.message)))?;
+        Slave::from_body_in(body, path.parent())
+    }
+
+    /// A fresh instance of `body_file` (parameters at their start values, Instantiated); a mesh
+    /// file it names is looked up relative to the current directory.
     pub fn from_body(body_file: BodyFile) -> Result<Slave> {
+        Slave::from_body_in(body_file, None)
+    }
+
+    /// [`Slave::from_body`] with mesh files looked up in `base_dir` (the body file's directory).
+    pub fn from_body_in(body_file: BodyFile, base_dir: Option<&Path>) -> Result<Slave> {
         body_file.check()?;
-        let mesh = match &body_file.mesh {
-            MeshSpec::Beam {
-                length,
-                width,
-                height,
-                divisions,
-                element,
-            } => mesh::beam(*length, *width, *height, *divisions, *element)?,
-        };
+        let mesh = body_file.mesh.build(base_dir)?;
         let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
         let lumped = fem::lumped_masses(&mesh, 1.0);
         let mut interfaces = Vec::new();
