@@ -55,3 +55,8 @@ pub fn initialized(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
 pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     initialized(BodyFile::default_body(), settings)
 }
+
+/// The body file at `path`.
+pub fn example_body_at(path: &std::path::Path) -> BodyFile {
+    BodyFile::from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
