@@ -129,3 +129,121 @@ fn a_relative_mesh_path_without_a_base_is_relative_to_the_current_directory() {
         e.message
     );
 }
+
+/// The `DataArray` named `name` of a `.vtu` text: its numbers.
+fn data_array(vtu: &str, name: &str) -> Vec<f64> {
+    let start = vtu
+        .find(&format!("Name=\"{name}\""))
+        .unwrap_or_else(|| panic!("no array {name}"));
+    let body_start = start + vtu[start..].find('>').unwrap() + 1;
+    let body_end = body_start + vtu[body_start..].find("</DataArray>").unwrap();
+    vtu[body_start..body_end]
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn vtk_results_of_the_conrod_are_written_at_the_interval() {
+    let dir = scratch("vtk");
+    let mut slave = Slave::from_body_path(&examples().join("conrod.json")).unwrap();
+    slave.setup_experiment(0.0, None, None).unwrap();
+    slave.enter_initialization_mode().unwrap();
+    let directory = slave
+        .variables()
+        .by_name("output.directory")
+        .unwrap()
+        .value_reference;
+    slave
+        .set_string(directory, &dir.join("results").display().to_string())
+        .unwrap();
+    common::set(&mut slave, "output.interval", 2e-4);
+    slave.exit_initialization_mode().unwrap();
+    common::set(&mut slave, "small_eye.force[2]", 5e3);
+    for k in 0..5 {
+        slave.do_step(k as f64 * 1e-4, 1e-4).unwrap();
+    }
+    let messages: Vec<String> = slave.drain_events().map(|e| e.message).collect();
+    assert!(
+        messages.iter().any(|m| m.contains("writing VTK results")),
+        "{messages:?}"
+    );
+    // Saved at t = 0, 2e-4 and 4e-4 (the interval from the last saved time).
+    let pvd = std::fs::read_to_string(dir.join("results/conrod.pvd")).unwrap();
+    let files: Vec<&str> = pvd
+        .lines()
+        .filter_map(|l| l.split("file=\"").nth(1))
+        .map(|l| l.trim_end_matches("\"/>"))
+        .collect();
+    assert_eq!(
+        files,
+        [
+            "conrod_000000.vtu",
+            "conrod_000001.vtu",
+            "conrod_000002.vtu"
+        ],
+        "{pvd}"
+    );
+    assert!(pvd.contains("timestep=\"4e-4\""), "{pvd}");
+    let n = slave.mesh().node_count();
+    let last = std::fs::read_to_string(dir.join("results").join(files[2])).unwrap();
+    assert!(last.contains(&format!("NumberOfPoints=\"{n}\"")));
+    let displacement = data_array(&last, "displacement");
+    let stress = data_array(&last, "vonMises");
+    let velocity = data_array(&last, "velocity");
+    assert_eq!(displacement.len(), 3 * n);
+    assert_eq!(stress.len(), n);
+    assert!(displacement
+        .iter()
+        .chain(&stress)
+        .chain(&velocity)
+        .all(|v| v.is_finite()));
+    // The loaded small eye moves in +y; the driven big eye stays put; the rod is stressed.
+    let small = slave.mesh().group("small_eye").unwrap();
+    let big = slave.mesh().group("big_eye").unwrap();
+    let mean_y = |nodes: &[usize]| {
+        nodes.iter().map(|&i| displacement[3 * i + 1]).sum::<f64>() / nodes.len() as f64
+    };
+    assert!(mean_y(small) > 1e-8, "{}", mean_y(small));
+    assert!(big.iter().all(|&i| displacement[3 * i + 1].abs() < 1e-12));
+    let peak = stress.iter().fold(0.0f64, |m, &s| m.max(s));
+    println!("conrod after 0.4 ms of 5 kN lateral: small eye dy = {:.3e} m, peak von Mises {peak:.3e} Pa", mean_y(small));
+    assert!(peak > 1e5 && peak < 1e10, "{peak:e}");
+    let first = std::fs::read_to_string(dir.join("results").join(files[0])).unwrap();
+    assert!(data_array(&first, "vonMises")
+        .iter()
+        .all(|&s| s.abs() < 1e-3));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn an_unwritable_output_directory_is_a_logged_error_not_a_failure() {
+    let dir = scratch("unwritable");
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, b"not a directory").unwrap();
+    let mut slave = Slave::from_body(BodyFile::default_body()).unwrap();
+    slave.setup_experiment(0.0, None, None).unwrap();
+    slave.enter_initialization_mode().unwrap();
+    let directory = slave
+        .variables()
+        .by_name("output.directory")
+        .unwrap()
+        .value_reference;
+    let target = blocker.join("results").display().to_string();
+    slave.set_string(directory, &target).unwrap();
+    assert_eq!(slave.get_string(directory).unwrap(), target);
+    slave.exit_initialization_mode().unwrap();
+    slave.do_step(0.0, 1e-3).unwrap();
+    let errors: Vec<String> = slave
+        .drain_events()
+        .filter(|e| e.category == "logStatusError")
+        .map(|e| e.message)
+        .collect();
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert!(
+        errors[0].contains("cannot create the directory") && errors[0].contains(&target),
+        "{}",
+        errors[0]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -137,7 +137,11 @@ pub fn parse(bytes: &[u8], scale: f64) -> Result<Mesh> {
     // a panic here must become an error too.
     let parsed = std::panic::catch_unwind(|| {
         mshio::parse_msh_bytes(bytes).map_err(|e| {
-            let mut message = e.to_string().split_whitespace().collect::<Vec<_>>().join(" ");
+            let mut message = e
+                .to_string()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join(" ");
             if message.len() > 600 {
                 let mut cut = 600;
                 while !message.is_char_boundary(cut) {

@@ -25,6 +25,7 @@ pub fn set(slave: &mut Slave, name: &str, value: f64) {
         VariableType::Real => slave.set_real(v.value_reference, value).unwrap(),
         VariableType::Integer => slave.set_integer(v.value_reference, value as i32).unwrap(),
         VariableType::Boolean => slave.set_boolean(v.value_reference, value != 0.0).unwrap(),
+        VariableType::String => panic!("{name} is a String: use Slave::set_string"),
     }
 }
 
