@@ -550,6 +550,7 @@ impl<S: CoSimSlave> Instance<S> {
                 VariableType::Real,
                 VariableType::Integer,
                 VariableType::Boolean,
+                VariableType::String,
             ]
             .into_iter()
             .find_map(|t| table.get(t, vr));
@@ -1239,9 +1240,16 @@ mod tests {
         assert!(last_message(&log).contains("not a Boolean variable"));
         assert_eq!(i.set_values("fmi2SetInteger", &[12345], &[1]), ERR);
         assert!(last_message(&log).contains("unknown Integer value reference 12345"));
-        assert_eq!(i.strings("fmi2GetString", &[], false), OK);
-        assert_eq!(i.strings("fmi2GetString", &[YOUNG], false), ERR);
-        assert!(last_message(&log).contains("unknown String value reference 1"));
+        assert_eq!(i.get_strings("fmi2GetString", &[]).0, OK);
+        assert_eq!(i.get_strings("fmi2GetString", &[YOUNG]).0, ERR);
+        assert!(last_message(&log).contains("not a String variable"));
+        assert_eq!(
+            i.set_strings("fmi2SetString", &[YOUNG], &[Some("x".into())]),
+            ERR
+        );
+        assert!(last_message(&log).contains("not a String variable"));
+        assert_eq!(i.get_strings("fmi2GetString", &[12345]).0, ERR);
+        assert!(last_message(&log).contains("unknown String value reference 12345"));
         assert_eq!(i.state(), M::StepComplete);
     }
 
