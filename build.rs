@@ -95,7 +95,7 @@ fn main() {
     let mut names = BTreeSet::new();
     let mut table = String::new();
     for v in &spec.variables {
-        let ty = variant(&v.ty, &["Real", "Integer", "Boolean"], "type");
+        let ty = variant(&v.ty, &["Real", "Integer", "Boolean", "String"], "type");
         let causality = variant(&v.causality, &["parameter", "input", "output"], "causality");
         let variability = variant(
             &v.variability,

@@ -40,6 +40,7 @@ fn run(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Result<Run, String>
             VariableType::Integer => s.set_integer(v.value_reference, *value),
             VariableType::Boolean => s.set_boolean(v.value_reference, *value != 0),
             VariableType::Real => s.set_real(v.value_reference, *value as f64),
+            VariableType::String => Err(flexbody::Error::new(format!("{name} is a String"))),
         }
         .map_err(|e| e.message)?;
     }

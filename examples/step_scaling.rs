@@ -57,7 +57,9 @@ fn main() {
     println!("|---|---|---|---|---|---|---|---|---|");
     for &divisions in sizes {
         let mut body_file = BodyFile::default_body();
-        let MeshSpec::Beam { divisions: d, .. } = &mut body_file.mesh;
+        let MeshSpec::Beam { divisions: d, .. } = &mut body_file.mesh else {
+            unreachable!("the default body is a beam")
+        };
         *d = divisions;
         let started = Instant::now();
         let mut s = Slave::from_body(body_file).unwrap();

@@ -57,6 +57,7 @@ fn slave(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Slave {
             VariableType::Integer => s.set_integer(v.value_reference, *value),
             VariableType::Boolean => s.set_boolean(v.value_reference, *value != 0),
             VariableType::Real => s.set_real(v.value_reference, *value as f64),
+            VariableType::String => panic!("{name} is a String"),
         }
         .unwrap();
     }

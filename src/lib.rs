@@ -14,6 +14,7 @@ pub mod fem;
 pub mod fmi2;
 pub mod mesh;
 pub mod model;
+pub mod output;
 pub mod slave;
 pub mod solver;
 

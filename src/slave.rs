@@ -10,14 +10,14 @@ use crate::body::{Body, BodyOptions, NodeSet, Patches};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
-use crate::mesh::{self, Mesh};
+use crate::mesh::Mesh;
 use crate::model::body_file::Integrator;
-use crate::model::body_file::MeshSpec;
 use crate::model::model_description::{format_real, model_description, ModelInfo};
 use crate::model::variables::{
     EnumerationSpec, FixedKey, InterfaceQuantity, FIXED_TABLE_FINGERPRINT,
 };
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
+use crate::output::ResultWriter;
 use crate::solver::anderson::MAX_DEPTH;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
@@ -100,6 +100,10 @@ pub struct Parameters {
     pub anderson_depth: i32,
     /// `solver.integrator`: 1 generalized-α, 2 central difference.
     pub integrator: i32,
+    /// `output.directory`: where VTK results go; empty: none (see [`crate::output`]).
+    pub output_directory: String,
+    /// `output.interval` (s): smallest time between saved results; 0: every communication point.
+    pub output_interval: f64,
 }
 
 impl Parameters {
@@ -130,6 +134,8 @@ impl Parameters {
                 Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
                 Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
             },
+            output_directory: String::new(),
+            output_interval: 0.0,
         }
     }
 
@@ -170,6 +176,7 @@ impl Parameters {
             FixedKey::StepSize if value <= 0.0 => Some("must be positive"),
             FixedKey::RhoInf if !(0.0..=1.0).contains(&value) => Some("must lie in [0, 1]"),
             FixedKey::Tolerance if !(value > 0.0 && value < 1.0) => Some("must lie in (0, 1)"),
+            FixedKey::OutputInterval if value < 0.0 => Some("must not be negative"),
             _ => None,
         };
         match reason {
@@ -289,6 +296,8 @@ pub struct Slave {
     retries: u64,
     /// Messages for the logger, drained by the FMI layer after each call.
     events: Vec<LogEvent>,
+    /// The VTK results of this run, if `output.directory` is set.
+    results: Option<ResultWriter>,
 }
 
 impl Slave {
@@ -304,21 +313,29 @@ impl Slave {
             }
             _ => BodyFile::default_body(),
         };
-        Slave::from_body(body)
+        Slave::from_body_in(body, resource_dir)
     }
 
-    /// A fresh instance of `body_file` (parameters at their start values, Instantiated).
+    /// Reads the body file at `path` (a mesh file it names is looked up beside it).
+    pub fn from_body_path(path: &Path) -> Result<Slave> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::new(format!("cannot read the body file {}: {e}", path.display()))
+        })?;
+        let body = BodyFile::from_json(&text)
+            .map_err(|e| Error::new(format!("{}: {}", path.display(), e.message)))?;
+        Slave::from_body_in(body, path.parent())
+    }
+
+    /// A fresh instance of `body_file` (parameters at their start values, Instantiated); a mesh
+    /// file it names is looked up relative to the current directory.
     pub fn from_body(body_file: BodyFile) -> Result<Slave> {
+        Slave::from_body_in(body_file, None)
+    }
+
+    /// [`Slave::from_body`] with mesh files looked up in `base_dir` (the body file's directory).
+    pub fn from_body_in(body_file: BodyFile, base_dir: Option<&Path>) -> Result<Slave> {
         body_file.check()?;
-        let mesh = match &body_file.mesh {
-            MeshSpec::Beam {
-                length,
-                width,
-                height,
-                divisions,
-                element,
-            } => mesh::beam(*length, *width, *height, *divisions, *element)?,
-        };
+        let mesh = body_file.mesh.build(base_dir)?;
         let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
         let lumped = fem::lumped_masses(&mesh, 1.0);
         let mut interfaces = Vec::new();
@@ -410,6 +427,7 @@ impl Slave {
             statistics: (0, 0),
             retries: 0,
             events: Vec::new(),
+            results: None,
         })
     }
 
@@ -479,7 +497,97 @@ impl Slave {
         self.ensure_initial_state()?;
         let h = self.parameters.step_size;
         self.matrix_index(h)?;
+        self.results = None;
+        if !self.parameters.output_directory.is_empty() {
+            match ResultWriter::create(
+                &self.parameters.output_directory,
+                &file_stem(&self.body_file.name),
+                self.parameters.output_interval,
+            ) {
+                Ok(writer) => {
+                    self.events.push(LogEvent {
+                        category: "logEvents",
+                        message: format!(
+                            "output.directory: writing VTK results to {}",
+                            writer.collection_path().display()
+                        ),
+                    });
+                    self.results = Some(writer);
+                    self.write_results();
+                }
+                Err(e) => self.output_failed(&e),
+            }
+        }
         Ok(())
+    }
+
+    /// Writes the current state to the results if they are on and a state is due. A file error
+    /// is logged and switches the results off: it never fails the simulation.
+    fn write_results(&mut self) {
+        let (Some(writer), Some(model), Some(dynamics)) = (
+            self.results.as_mut(),
+            self.model.as_ref(),
+            self.dynamics.as_ref(),
+        ) else {
+            return;
+        };
+        let s = &dynamics.state;
+        if !writer.is_due(s.time) {
+            return;
+        }
+        if let Err(e) = writer.write(
+            s.time,
+            &self.mesh,
+            &self.parameters.material,
+            &model.body,
+            &s.position,
+            &s.velocity,
+        ) {
+            self.output_failed(&e);
+        }
+    }
+
+    /// Logs a failure to write results (an error message; the call itself succeeds) and stops
+    /// writing.
+    fn output_failed(&mut self, reason: &str) {
+        self.results = None;
+        self.events.push(LogEvent {
+            category: "logStatusError",
+            message: format!(
+                "error: output.directory = '{}': {reason}; no further results are written (the simulation goes on)",
+                self.parameters.output_directory
+            ),
+        });
+    }
+
+    /// Value of a String variable.
+    pub fn get_string(&mut self, vr: u32) -> Result<String> {
+        let v = self.lookup(VariableType::String, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::OutputDirectory,
+                ..
+            } => Ok(self.parameters.output_directory.clone()),
+            _ => Err(Error::new(format!(
+                "no String variable has value reference {vr}"
+            ))),
+        }
+    }
+
+    /// Sets a String parameter (`output.directory`: any text; a directory that cannot be created
+    /// is reported when the results are first written).
+    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        let v = self.lookup(VariableType::String, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::OutputDirectory,
+                ..
+            } => {
+                self.parameters.output_directory = value.to_string();
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
     }
 
     /// Current simulation time (s): the last successful communication point.
@@ -542,6 +650,7 @@ impl Slave {
         self.statistics = (0, 0);
         self.retries = 0;
         self.outputs.valid = false;
+        self.results = None;
     }
 
     /// `fmi2GetFMUstate`.
@@ -608,6 +717,7 @@ impl Slave {
             (VariableType::Real, Target::Fixed { key, component }) => {
                 format_real(read_parameter(&self.defaults, key, component).unwrap_or(0.0))
             }
+            (VariableType::String, Target::Fixed { .. }) => self.defaults.output_directory.clone(),
             (
                 VariableType::Real,
                 Target::Interface {
@@ -1139,6 +1249,9 @@ impl Slave {
                             ),
                         });
                     }
+                }
+                if self.results.is_some() {
+                    self.write_results();
                 }
                 Ok(())
             }
@@ -1938,10 +2051,46 @@ fn body_output_slot(key: FixedKey) -> usize {
     }
 }
 
-/// Value of a Real parameter (`None` for outputs and non-Real keys).
+/// Value of a Real parameter (`None` for outputs and non-Real keys). Allocation-free.
 fn read_parameter(p: &Parameters, key: FixedKey, c: usize) -> Option<f64> {
-    let mut copy = p.clone();
-    write_parameter(&mut copy, key, c).map(|v| *v)
+    use FixedKey::*;
+    Some(match key {
+        YoungsModulus => p.material.youngs_modulus,
+        PoissonRatio => p.material.poisson_ratio,
+        Density => p.material.density,
+        DampingAlpha => p.damping_alpha,
+        DampingBeta => p.damping_beta,
+        Gravity => p.gravity[c],
+        InitialPosition => p.initial_position[c],
+        InitialRotation => p.initial_rotation[c],
+        InitialVelocity => p.initial_velocity[c],
+        InitialAngularVelocity => p.initial_angular_velocity[c],
+        StepSize => p.step_size,
+        RhoInf => p.rho_inf,
+        Tolerance => p.tolerance,
+        OutputInterval => p.output_interval,
+        _ => return None,
+    })
+}
+
+/// A file name made from a model name: characters other than letters, digits, `-`, `_` and `.`
+/// become `_`.
+fn file_stem(name: &str) -> String {
+    let stem: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if stem.is_empty() || stem.chars().all(|c| c == '.') {
+        "body".into()
+    } else {
+        stem
+    }
 }
 
 /// The storage of a Real parameter (`None` for outputs and non-Real keys).
@@ -1961,6 +2110,7 @@ fn write_parameter(p: &mut Parameters, key: FixedKey, c: usize) -> Option<&mut f
         StepSize => &mut p.step_size,
         RhoInf => &mut p.rho_inf,
         Tolerance => &mut p.tolerance,
+        OutputInterval => &mut p.output_interval,
         _ => return None,
     })
 }

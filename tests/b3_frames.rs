@@ -21,7 +21,9 @@ const END: f64 = 7.5;
 /// Tip deflection in the hub frame (m) at every step up to `END`, and iterations per step.
 fn run(settings: &[(&str, f64)]) -> (Vec<f64>, f64) {
     let mut body = example_body("hub_beam");
-    let MeshSpec::Beam { divisions, .. } = &mut body.mesh;
+    let MeshSpec::Beam { divisions, .. } = &mut body.mesh else {
+        unreachable!("B3 is a beam")
+    };
     divisions[0] = 20;
     let mut s = initialized(body, settings);
     let mut history = Vec::new();

@@ -109,7 +109,9 @@ fn a_thin_slender_section_follows_the_square_one() {
     // leaves room for the hex20 discretisation of the two sections.
     let square = example_body("hub_beam");
     let mut thin = square.clone();
-    let flexbody::model::body_file::MeshSpec::Beam { width, height, .. } = &mut thin.mesh;
+    let flexbody::model::body_file::MeshSpec::Beam { width, height, .. } = &mut thin.mesh else {
+        unreachable!("B3 is a beam")
+    };
     (*width, *height) = (0.07746, 0.005164);
     thin.material.youngs_modulus = 7e10;
     thin.material.density = 3000.0;

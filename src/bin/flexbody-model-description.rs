@@ -42,15 +42,12 @@ fn parse_args(args: impl IntoIterator<Item = String>) -> Result<Command, String>
 
 /// The modelDescription.xml of the body in `file` (or of the default body).
 fn describe(file: Option<&str>) -> Result<String, String> {
-    let body = match file {
-        Some(path) => {
-            let text =
-                std::fs::read_to_string(path).map_err(|e| format!("cannot read {path}: {e}"))?;
-            BodyFile::from_json(&text).map_err(|e| format!("{path}: {e}"))?
-        }
-        None => BodyFile::default_body(),
-    };
-    let slave = Slave::from_body(body).map_err(|e| e.to_string())?;
+    let slave = match file {
+        // A mesh file named by the body file is read from beside it.
+        Some(path) => Slave::from_body_path(std::path::Path::new(path)),
+        None => Slave::from_body(BodyFile::default_body()),
+    }
+    .map_err(|e| e.to_string())?;
     Ok(slave.model_description())
 }
 

@@ -2,15 +2,17 @@
 //!
 //! The sparsity pattern comes from the node graph (nodes sharing an element), built once per
 //! matrix; element matrices are computed into fixed-size stack arrays and scattered straight into
-//! the CSR values (no triplets, no per-element heap allocation). Both matrices use the full
-//! Gauss–Legendre rule of [`full_integration_points`] (2×2×2 for Hex8, 3×3×3 for Hex20).
+//! the CSR values (no triplets, no per-element heap allocation). `K` uses the rule of
+//! [`integration_rule`] (full Gauss–Legendre 2×2×2 for Hex8, 3×3×3 for Hex20; 1 point for Tet4,
+//! 4 for Tet10), the mass and the lumped masses that of [`mass_rule`] (the same for the
+//! hexahedra; 4 points for Tet4, 14 for Tet10).
 
-use super::element::{full_integration_points, physical_gradients, shape_functions, MAX_NODES};
-use super::quadrature::hexahedron_rule;
+use super::element::{integration_rule, mass_rule, physical_gradients, shape_functions, MAX_NODES};
+use super::quadrature::QuadraturePoint;
 use super::{IsotropicMaterial, SymmetricCsr};
 use crate::mesh::{ElementKind, Mesh};
 
-/// Shape function values and natural derivatives at the points of the full rule of `kind`.
+/// Shape function values and natural derivatives at the points of a rule of `kind`.
 struct ReferenceElement {
     weights: Vec<f64>,
     values: Vec<[f64; MAX_NODES]>,
@@ -18,11 +20,20 @@ struct ReferenceElement {
 }
 
 impl ReferenceElement {
+    /// At the points of the stiffness rule ([`integration_rule`]).
     fn new(kind: ElementKind) -> ReferenceElement {
-        let rule = hexahedron_rule(full_integration_points(kind));
+        Self::with_rule(kind, &integration_rule(kind))
+    }
+
+    /// At the points of the mass rule ([`mass_rule`]).
+    fn for_mass(kind: ElementKind) -> ReferenceElement {
+        Self::with_rule(kind, &mass_rule(kind))
+    }
+
+    fn with_rule(kind: ElementKind, rule: &[QuadraturePoint]) -> ReferenceElement {
         let mut values = Vec::with_capacity(rule.len());
         let mut derivatives = Vec::with_capacity(rule.len());
-        for q in &rule {
+        for q in rule {
             let mut v = [0.0; MAX_NODES];
             let mut d = [[0.0; 3]; MAX_NODES];
             shape_functions(kind, q.xi, &mut v, &mut d);
@@ -114,7 +125,7 @@ fn element_coordinates(mesh: &Mesh, e: usize, coords: &mut [[f64; 3]; MAX_NODES]
 /// The mass matrix of the body is `M = Ms ⊗ I3`. `Σ_ij Ms[i,j] = ρ V` (partition of unity).
 pub fn scalar_mass_matrix(mesh: &Mesh, density: f64) -> SymmetricCsr {
     let graph = NodeGraph::new(mesh);
-    let reference = ReferenceElement::new(mesh.kind());
+    let reference = ReferenceElement::for_mass(mesh.kind());
     let n = mesh.kind().node_count();
     let mut values = vec![0.0; graph.neighbours.len()];
     let mut coords = [[0.0; 3]; MAX_NODES];
@@ -276,7 +287,7 @@ pub fn stiffness_matrix(mesh: &Mesh, material: &IsotropicMaterial) -> SymmetricC
 /// HRZ-lumped (diagonal-scaled) nodal masses (kg): `m_i = Ms[i,i] · m_e / Σ_j Ms_e[j,j]` summed
 /// over elements; all positive, summing to the total mass `ρV`.
 pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
-    let reference = ReferenceElement::new(mesh.kind());
+    let reference = ReferenceElement::for_mass(mesh.kind());
     let n = mesh.kind().node_count();
     let mut lumped = vec![0.0; mesh.node_count()];
     let mut coords = [[0.0; 3]; MAX_NODES];
@@ -310,7 +321,7 @@ pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
 #[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
-    use crate::fem::element::{natural_coordinates, HEX_EDGES};
+    use crate::fem::element::{edges, natural_coordinates};
     use crate::mesh::beam;
     use crate::solver::cholesky::SparseCholesky;
     use nalgebra::{DMatrix, SymmetricEigen};
@@ -345,10 +356,10 @@ mod tests {
         Mesh::new(nodes, kind, (0..kind.node_count()).collect()).unwrap()
     }
 
-    /// Places every Hex20 mid-edge node at the midpoint of its edge's corners.
+    /// Places every Hex20 or Tet10 mid-edge node at the midpoint of its edge's corners.
     fn straighten_edges(nodes: &mut [[f64; 3]], kind: ElementKind, element: &[usize]) {
-        if kind == ElementKind::Hex20 {
-            for (a, b, mid) in HEX_EDGES {
+        if kind.is_quadratic() {
+            for &(a, b, mid) in edges(kind) {
                 let (pa, pb) = (nodes[element[a]], nodes[element[b]]);
                 nodes[element[mid]] = [
                     0.5 * (pa[0] + pb[0]),
@@ -408,7 +419,7 @@ mod tests {
         let d = DMatrix::from_fn(6, 6, |r, c| material.elasticity_matrix()[r][c]);
         let mut k = DMatrix::zeros(3 * n, 3 * n);
         let coords: Vec<[f64; 3]> = mesh.element(0).iter().map(|&i| mesh.nodes()[i]).collect();
-        for q in hexahedron_rule(full_integration_points(kind)) {
+        for q in integration_rule(kind) {
             let mut v = [0.0; MAX_NODES];
             let mut dn = [[0.0; 3]; MAX_NODES];
             let mut g = [[0.0; 3]; MAX_NODES];
@@ -474,11 +485,27 @@ mod tests {
                 assert_eq!(ms.to_dense(), ms.to_dense().transpose());
             }
         }
-        // Why HRZ: the consistent row sums of a Hex20 are negative at the corners.
+        // Why HRZ: the consistent row sums of a Hex20 are negative at the corners, and those of a
+        // Tet10 too (−ρV/20 for a single element: ∫ L(2L − 1) dV = −V/20).
         let cube = beam(1.0, 1.0, 1.0, [1, 1, 1], ElementKind::Hex20).unwrap();
         let ms = scalar_mass_matrix(&cube, rho);
         let corner_row: f64 = ms.row(cube.element(0)[0]).1.iter().sum();
         assert!(corner_row < 0.0, "corner row sum {corner_row}");
+        let tet = Mesh::new(
+            crate::fem::element::TET10_NODES.to_vec(),
+            ElementKind::Tet10,
+            (0..10).collect(),
+        )
+        .unwrap();
+        let ms = scalar_mass_matrix(&tet, rho);
+        let volume = 1.0 / 6.0;
+        for corner in 0..4 {
+            let row: f64 = ms.row(corner).1.iter().sum();
+            assert!(
+                (row + rho * volume / 20.0).abs() < 1e-12 * rho * volume,
+                "Tet10 corner row sum {row}"
+            );
+        }
     }
 
     /// 2×2×2 block `[0,2]×[−1,1]²` with the interior corner node and the face-centre corner nodes
@@ -539,9 +566,11 @@ mod tests {
             let interior: Vec<usize> = (0..mesh.node_count())
                 .filter(|&i| !on_boundary(&mesh.nodes()[i]))
                 .collect();
+            // Tet10: every point of the 5×5×5 lattice is a node (module doc of `beam`).
             let expected_interior = match kind {
-                ElementKind::Hex8 => 1,
+                ElementKind::Hex8 | ElementKind::Tet4 => 1,
                 ElementKind::Hex20 => 7,
+                ElementKind::Tet10 => 27,
             };
             assert_eq!(interior.len(), expected_interior);
             let free: Vec<usize> = interior
@@ -584,7 +613,7 @@ mod tests {
             for el in 0..mesh.element_count() {
                 let nodes = mesh.element(el);
                 let coords: Vec<[f64; 3]> = nodes.iter().map(|&i| mesh.nodes()[i]).collect();
-                for q in hexahedron_rule(full_integration_points(kind)) {
+                for q in integration_rule(kind) {
                     shape_functions(kind, q.xi, &mut v, &mut dn);
                     physical_gradients(&coords, &dn[..n], &mut g[..n]);
                     for r in 0..3 {

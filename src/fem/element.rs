@@ -1,14 +1,20 @@
-//! Shape functions of the hexahedra in natural coordinates `ξ = (ξ, η, ζ) ∈ [−1, 1]³`, the
-//! isoparametric Jacobian and physical shape-function gradients.
+//! Shape functions of the hexahedra (natural coordinates `ξ = (ξ, η, ζ) ∈ [−1, 1]³`) and of the
+//! tetrahedra (natural coordinates in the unit tetrahedron `ξ, η, ζ ≥ 0, ξ + η + ζ ≤ 1`), the
+//! isoparametric Jacobian, physical shape-function gradients and the quadrature rule of each kind.
 //!
 //! * Hex8 (trilinear): `N_a = ⅛ (1 + ξ ξ_a)(1 + η η_a)(1 + ζ ζ_a)`.
 //! * Hex20 (serendipity): corner nodes
 //!   `N_a = ⅛ (1 + ξ ξ_a)(1 + η η_a)(1 + ζ ζ_a)(ξ ξ_a + η η_a + ζ ζ_a − 2)`; a mid-edge node with
 //!   natural coordinate 0 along one axis, e.g. `ξ_a = 0`: `N_a = ¼ (1 − ξ²)(1 + η η_a)(1 + ζ ζ_a)`.
+//! * Tet4 (linear): with the barycentric coordinates `L_0 = 1 − ξ − η − ζ`, `L_1 = ξ`, `L_2 = η`,
+//!   `L_3 = ζ`: `N_a = L_a`.
+//! * Tet10 (quadratic): corners `N_a = L_a (2 L_a − 1)`, the node in the middle of edge `(a, b)`
+//!   `N = 4 L_a L_b`.
 //!
-//! Node order is VTK's (see [`natural_coordinates`]). Both families are partitions of unity and
+//! Node order is VTK's (see [`natural_coordinates`]). All families are partitions of unity and
 //! reproduce linear fields, so an isoparametric element represents `u = A X + b` exactly.
 
+use super::quadrature::{hexahedron_rule, tetrahedron_rule, QuadraturePoint};
 use crate::mesh::ElementKind;
 
 /// Largest node count of an element kind (for fixed-size, allocation-free local arrays).
@@ -69,20 +75,93 @@ pub const HEX_EDGES: [(usize, usize, usize); 12] = [
     (3, 7, 19),
 ];
 
+/// Natural coordinates of the Tet4 nodes (VTK_TETRA order): the vertices `L_0 … L_3 = 1`.
+pub const TET4_NODES: [[f64; 3]; 4] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+
+/// Natural coordinates of the Tet10 nodes (VTK_QUADRATIC_TETRA order): the 4 vertices as Tet4,
+/// then the middles of edges 0-1, 1-2, 2-0, 0-3, 1-3, 2-3 (nodes 4–9). Gmsh's order differs
+/// in the last two (its node 8 is on edge 2-3, node 9 on edge 1-3).
+pub const TET10_NODES: [[f64; 3]; 10] = [
+    [0.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [0.5, 0.0, 0.0],
+    [0.5, 0.5, 0.0],
+    [0.0, 0.5, 0.0],
+    [0.0, 0.0, 0.5],
+    [0.5, 0.0, 0.5],
+    [0.0, 0.5, 0.5],
+];
+
+/// The 6 edges of a tetrahedron as (vertex, vertex, mid-edge node of Tet10), VTK numbering.
+pub const TET_EDGES: [(usize, usize, usize); 6] = [
+    (0, 1, 4),
+    (1, 2, 5),
+    (2, 0, 6),
+    (0, 3, 7),
+    (1, 3, 8),
+    (2, 3, 9),
+];
+
 /// Natural coordinates of the nodes of `kind`, in element node order.
 pub fn natural_coordinates(kind: ElementKind) -> &'static [[f64; 3]] {
     match kind {
         ElementKind::Hex8 => &HEX8_NODES,
         ElementKind::Hex20 => &HEX20_NODES,
+        ElementKind::Tet4 => &TET4_NODES,
+        ElementKind::Tet10 => &TET10_NODES,
     }
 }
 
-/// Gauss points per axis of the full integration rule used for both `M` and `K`: 2 for Hex8
-/// (2×2×2), 3 for Hex20 (3×3×3).
-pub fn full_integration_points(kind: ElementKind) -> usize {
+/// Edges of the element as (corner, corner, mid-edge node): the mid-edge node is meaningful for
+/// the quadratic kinds (Hex20, Tet10) only.
+pub fn edges(kind: ElementKind) -> &'static [(usize, usize, usize)] {
     match kind {
-        ElementKind::Hex8 => 2,
-        ElementKind::Hex20 => 3,
+        ElementKind::Hex8 | ElementKind::Hex20 => &HEX_EDGES,
+        ElementKind::Tet4 | ElementKind::Tet10 => &TET_EDGES,
+    }
+}
+
+/// Corner (vertex) nodes per element: the first `corner_count` nodes in VTK order.
+pub fn corner_count(kind: ElementKind) -> usize {
+    match kind {
+        ElementKind::Hex8 | ElementKind::Hex20 => 8,
+        ElementKind::Tet4 | ElementKind::Tet10 => 4,
+    }
+}
+
+/// The quadrature rule for the stiffness `K` (and everything evaluated per Gauss point: stress,
+/// `K_G`, the St. Venant–Kirchhoff solid). Weights sum to the volume of the reference element
+/// (8 for the cube, 1/6 for the unit tetrahedron).
+///
+/// * Hex8: 2×2×2 Gauss–Legendre; Hex20: 3×3×3 (the full rules).
+/// * Tet4: 1 point (the centroid; `∇N` is constant, so `K` is exact on straight elements).
+/// * Tet10: 4 points, degree 2 (`∇N_a · ∇N_b` is quadratic on a straight-edged element: exact).
+pub fn integration_rule(kind: ElementKind) -> Vec<QuadraturePoint> {
+    match kind {
+        ElementKind::Hex8 => hexahedron_rule(2),
+        ElementKind::Hex20 => hexahedron_rule(3),
+        ElementKind::Tet4 => tetrahedron_rule(1),
+        ElementKind::Tet10 => tetrahedron_rule(2),
+    }
+}
+
+/// The quadrature rule for the consistent mass `∫ ρ N_a N_b dV` (and the HRZ-lumped masses):
+/// the hexahedra use the rule of [`integration_rule`] (exact for the mass of a parallelepiped);
+/// the tetrahedra need the degree of `N_a N_b`: Tet4 the 4-point degree-2 rule, Tet10 the
+/// 14-point degree-5 rule (degree 4 is needed; unlike the 11-point degree-4 Keast rule its
+/// weights are all positive).
+pub fn mass_rule(kind: ElementKind) -> Vec<QuadraturePoint> {
+    match kind {
+        ElementKind::Hex8 | ElementKind::Hex20 => integration_rule(kind),
+        ElementKind::Tet4 => tetrahedron_rule(2),
+        ElementKind::Tet10 => tetrahedron_rule(5),
     }
 }
 
@@ -94,14 +173,49 @@ pub fn shape_functions(
     values: &mut [f64],
     derivatives: &mut [[f64; 3]],
 ) {
-    let nodes = natural_coordinates(kind);
-    for (a, node) in nodes.iter().enumerate() {
-        let (n, dn) = match kind {
-            ElementKind::Hex8 => trilinear(node, xi),
-            ElementKind::Hex20 => serendipity(node, xi),
-        };
-        values[a] = n;
-        derivatives[a] = dn;
+    match kind {
+        ElementKind::Hex8 | ElementKind::Hex20 => {
+            let nodes = natural_coordinates(kind);
+            for (a, node) in nodes.iter().enumerate() {
+                let (n, dn) = match kind {
+                    ElementKind::Hex8 => trilinear(node, xi),
+                    _ => serendipity(node, xi),
+                };
+                values[a] = n;
+                derivatives[a] = dn;
+            }
+        }
+        ElementKind::Tet4 | ElementKind::Tet10 => tetrahedral(kind, xi, values, derivatives),
+    }
+}
+
+/// Barycentric coordinates `L_0 … L_3` at `ξ` and their (constant) natural gradients.
+const BARYCENTRIC_GRADIENTS: [[f64; 3]; 4] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+];
+
+/// Tet4 and Tet10 shape functions (module documentation) and their natural derivatives.
+fn tetrahedral(kind: ElementKind, xi: [f64; 3], values: &mut [f64], derivatives: &mut [[f64; 3]]) {
+    let l = [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]];
+    let dl = &BARYCENTRIC_GRADIENTS;
+    if kind == ElementKind::Tet4 {
+        values[..4].copy_from_slice(&l);
+        derivatives[..4].copy_from_slice(dl);
+        return;
+    }
+    for a in 0..4 {
+        // L (2L − 1), derivative (4L − 1) ∇L.
+        values[a] = l[a] * (2.0 * l[a] - 1.0);
+        let s = 4.0 * l[a] - 1.0;
+        derivatives[a] = [s * dl[a][0], s * dl[a][1], s * dl[a][2]];
+    }
+    for &(a, b, m) in &TET_EDGES {
+        // 4 L_a L_b, derivative 4 (L_b ∇L_a + L_a ∇L_b).
+        values[m] = 4.0 * l[a] * l[b];
+        derivatives[m] = std::array::from_fn(|j| 4.0 * (l[b] * dl[a][j] + l[a] * dl[b][j]));
     }
 }
 

@@ -10,12 +10,12 @@
 //!
 //! (`∇N_a` the physical shape-function gradients, 1/m). `K_G` is symmetric, linear in `S0`, and
 //! block-diagonal in the directions (`(∇N_a · S0 ∇N_b) I3` per node pair). It is integrated with
-//! the same full Gauss rule as `K` ([`full_integration_points`]), one stress per Gauss point.
+//! the same rule as `K` ([`integration_rule`]), one stress per Gauss point.
 //!
 //! **Gauss-point order** (of [`stress_at_gauss_points`] and of the `stress` argument of the
 //! assembly routines): element by element (`e = 0, 1, …`), and within an element the points of
-//! [`hexahedron_rule`]`(`[`full_integration_points`]`(kind))` in that rule's order (ξ fastest,
-//! then η, then ζ). Index `e · p + q` with `p` = [`gauss_points_per_element`]. Stresses are Voigt
+//! [`integration_rule`]`(kind)` in that rule's order (for the hexahedra ξ fastest, then η, then
+//! ζ). Index `e · p + q` with `p` = [`gauss_points_per_element`]. Stresses are Voigt
 //! vectors `[σ_xx, σ_yy, σ_zz, σ_yz, σ_xz, σ_xy]` (Pa).
 //!
 //! **Pattern.** Every matrix built here has exactly the sparsity pattern of
@@ -26,14 +26,19 @@
 //! cases value by value without looking at indices.
 
 pub use super::assembly::stiffness_pattern;
-use super::element::{full_integration_points, physical_gradients, shape_functions, MAX_NODES};
-use super::quadrature::hexahedron_rule;
+use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use super::{IsotropicMaterial, SymmetricCsr};
 use crate::mesh::{ElementKind, Mesh};
 
-/// Gauss points of the full rule per element of `kind` (8 for Hex8, 27 for Hex20).
+/// Gauss points of the stiffness rule per element of `kind` (8 for Hex8, 27 for Hex20, 1 for
+/// Tet4, 4 for Tet10).
 pub fn gauss_points_per_element(kind: ElementKind) -> usize {
-    full_integration_points(kind).pow(3)
+    match kind {
+        ElementKind::Hex8 => 8,
+        ElementKind::Hex20 => 27,
+        ElementKind::Tet4 => 1,
+        ElementKind::Tet10 => 4,
+    }
 }
 
 /// Gauss points of the whole mesh: `element_count × gauss_points_per_element`.
@@ -50,7 +55,7 @@ struct ReferenceGradients {
 
 impl ReferenceGradients {
     fn new(kind: ElementKind) -> ReferenceGradients {
-        let rule = hexahedron_rule(full_integration_points(kind));
+        let rule = integration_rule(kind);
         let mut values = [0.0; MAX_NODES];
         let derivatives = rule
             .iter()
@@ -276,7 +281,7 @@ pub fn weighted_sum_into(out: &mut SymmetricCsr, terms: &[(f64, &SymmetricCsr)])
 #[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
-    use crate::fem::element::HEX_EDGES;
+    use crate::fem::element::{corner_count, edges};
     use crate::fem::stiffness_matrix;
     use crate::mesh::beam;
 
@@ -287,7 +292,7 @@ mod tests {
         let mut nodes = block.nodes().to_vec();
         for (i, p) in nodes.iter_mut().enumerate() {
             let is_corner = (0..block.element_count()).any(|e| {
-                block.element(e)[..8].contains(&i) // corners come first in VTK order
+                block.element(e)[..corner_count(kind)].contains(&i) // corners come first (VTK)
             });
             if is_corner {
                 // A smooth perturbation of at most 0.04 m on elements of 0.5 × 0.4 × 0.6 m.
@@ -297,10 +302,10 @@ mod tests {
                 p[2] += 0.02 * s * (1.0 - s);
             }
         }
-        if kind == ElementKind::Hex20 {
+        if kind.is_quadratic() {
             for e in 0..block.element_count() {
                 let element = block.element(e);
-                for (a, b, mid) in HEX_EDGES {
+                for &(a, b, mid) in edges(kind) {
                     let (pa, pb) = (nodes[element[a]], nodes[element[b]]);
                     nodes[element[mid]] = [
                         0.5 * (pa[0] + pb[0]),
@@ -395,15 +400,19 @@ mod tests {
         // every point, also on the distorted block, so uᵀ K_G u = Σ_gp w det J σ_xx |A e_x|²
         // = σ_xx V |A e_x|² with V = Σ_gp w det J (the quadrature of the volume, itself exact
         // here: det J of a trilinear map has degree ≤ 2 per natural variable, and the straight-
-        // edged Hex20 map is that trilinear map). Tolerance: round-off, 1e-12 relative.
+        // edged Hex20 map is that trilinear map; straight-edged tetrahedra have a constant det J).
+        // Tolerance: round-off, 1e-12 relative.
         let a = [[0.3, -0.2, 0.5], [0.7, 0.1, -0.4], [-0.6, 0.25, 0.15]];
         let b = [0.01, -0.02, 0.03];
         let sigma = 3.7e6;
         for kind in ElementKind::ALL {
-            for mesh in [
+            for (m, mesh) in [
                 beam(1.3, 0.5, 0.4, [3, 2, 2], kind).unwrap(),
                 distorted_block(kind),
-            ] {
+            ]
+            .into_iter()
+            .enumerate()
+            {
                 let mut u = vec![0.0; 3 * mesh.node_count()];
                 for (i, p) in mesh.nodes().iter().enumerate() {
                     for r in 0..3 {
@@ -426,7 +435,7 @@ mod tests {
                             );
                     }
                 }
-                if mesh.element_count() == 12 {
+                if m == 0 {
                     // The regular 1.3 × 0.5 × 0.4 block.
                     assert!((volume / (1.3 * 0.5 * 0.4) - 1.0).abs() < 1e-13);
                 }
@@ -487,6 +496,8 @@ mod tests {
             let per_element = match kind {
                 ElementKind::Hex8 => 8,
                 ElementKind::Hex20 => 27,
+                ElementKind::Tet4 => 1,
+                ElementKind::Tet10 => 4,
             };
             assert_eq!(stress.len(), mesh.element_count() * per_element);
             for s in &stress {

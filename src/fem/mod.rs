@@ -10,6 +10,7 @@ pub mod modal;
 pub mod nonlinear;
 pub mod quadrature;
 pub mod sparse;
+pub mod stress;
 
 pub use assembly::{lumped_masses, scalar_mass_matrix, stiffness_matrix};
 pub use material::IsotropicMaterial;

@@ -8,7 +8,7 @@
 //! relative precision), the strain energy (J) is
 //!
 //! ```text
-//! W(x) = ∫ ½ λ (tr E)² + μ E:E dV     (reference volume, full Gauss rule: 2×2×2 Hex8, 3×3×3 Hex20)
+//! W(x) = ∫ ½ λ (tr E)² + μ E:E dV     (reference volume, the rule of `integration_rule`: 2×2×2 Hex8, 3×3×3 Hex20, 1 point Tet4, 4 Tet10)
 //! ```
 //!
 //! the second Piola–Kirchhoff stress (Pa) `S = λ tr(E) I + 2μ E`, the first Piola–Kirchhoff stress
@@ -29,8 +29,7 @@
 //! element block in the CSR values of `K`; the per-call routines use fixed-size stack arrays and
 //! do not allocate.
 
-use super::element::{full_integration_points, physical_gradients, shape_functions, MAX_NODES};
-use super::quadrature::hexahedron_rule;
+use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use super::{stiffness_matrix, IsotropicMaterial, SymmetricCsr};
 use crate::mesh::{ElementKind, Mesh};
 
@@ -95,7 +94,7 @@ impl SvkSolid {
     pub fn new(mesh: &Mesh, material: &IsotropicMaterial) -> SvkSolid {
         let kind = mesh.kind();
         let n = kind.node_count();
-        let rule = hexahedron_rule(full_integration_points(kind));
+        let rule = integration_rule(kind);
         let points = rule.len();
         let element_count = mesh.element_count();
         let node_count = mesh.node_count();
@@ -204,7 +203,7 @@ impl SvkSolid {
     }
 
     /// Reference positions `X` (m) of all Gauss points, element by element, within an element in
-    /// the order of [`hexahedron_rule`] (ξ fastest). The order of
+    /// the order of [`integration_rule`] (ξ fastest for the hexahedra). The order of
     /// [`Self::green_strain_at_gauss_points`].
     pub fn gauss_point_positions(&self) -> &[[f64; 3]] {
         &self.gauss_positions
@@ -600,11 +599,13 @@ mod tests {
     #[test]
     fn internal_force_is_the_gradient_of_the_strain_energy() {
         // Central differences: error ≤ h²/6 |W'''| + ε |W| / h. With E = 1 and strains ~0.1 the
-        // third derivative scales like |f| / ℓ² with ℓ ≈ 0.15–0.25 m the node spacing, so at
-        // h = 1e-5 the truncation is ~1e-11/6 · 40 |f| ≈ 1e-10 |f| and the rounding
-        // ~1e-16 · 1e-2 / 1e-5 = 1e-13. Measured: 1.3e-9 (Hex8) and 2.4e-9 (Hex20) · max|f|.
-        // The bound 1e-8 · max|f| keeps a margin and is far below any wrong term (≥ 1e-3).
-        let h = 1e-5;
+        // third derivative scales like |f| / ℓ² with ℓ ≈ 0.1–0.25 m the node spacing, so at
+        // h = 2.5e-6 the truncation is ~1e-12/6 · 100 |f| ≈ 2e-11 |f| and the rounding
+        // ~1e-16 · 6e-3 / 2.5e-6 ≈ 3e-13 (1e-11 |f|). The error was measured to scale as h²
+        // (truncation) at h = 2e-5, 1e-5, 5e-6: at 2.5e-6 it is 8e-11 (Hex8), 1.5e-10 (Hex20),
+        // 2.2e-10 (Tet4) and 7e-10 (Tet10, more nodes share the load) · max|f|. The bound
+        // 1e-8 · max|f| keeps a margin and is far below any wrong term (≥ 1e-3).
+        let h = 2.5e-6;
         for kind in ElementKind::ALL {
             let solid = SvkSolid::new(&distorted_patch(kind), &unit_material());
             let x = rotated_deformed(&solid);

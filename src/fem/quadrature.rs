@@ -1,8 +1,11 @@
-//! Gauss–Legendre quadrature on the reference hexahedron `ξ ∈ [−1, 1]³`.
+//! Quadrature on the reference elements: Gauss–Legendre on the hexahedron `ξ ∈ [−1, 1]³`, and
+//! symmetric rules on the unit tetrahedron `ξ, η, ζ ≥ 0, ξ + η + ζ ≤ 1` (volume 1/6).
 //!
 //! An `n`-point Gauss–Legendre rule integrates polynomials of degree `≤ 2n − 1` exactly on
 //! `[−1, 1]`; the tensor-product rule with `n` points per axis integrates every polynomial whose
-//! degree in each natural coordinate separately is `≤ 2n − 1` exactly on the cube.
+//! degree in each natural coordinate separately is `≤ 2n − 1` exactly on the cube. The
+//! tetrahedron rules integrate every polynomial of total degree `≤ d` exactly (see
+//! [`tetrahedron_rule`]).
 
 /// One point of a quadrature rule: natural coordinates `ξ` and weight (the weights of a rule on
 /// the cube sum to its volume, 8).
@@ -60,9 +63,128 @@ pub fn hexahedron_rule(points_per_axis: usize) -> Vec<QuadraturePoint> {
     out
 }
 
+/// Points of one symmetry orbit of the tetrahedron, given by barycentric coordinates.
+fn tetrahedron_orbit(out: &mut Vec<QuadraturePoint>, barycentric: &[[f64; 4]], weight: f64) {
+    // Natural coordinates (ξ, η, ζ) = (L_1, L_2, L_3).
+    for l in barycentric {
+        out.push(QuadraturePoint {
+            xi: [l[1], l[2], l[3]],
+            weight,
+        });
+    }
+}
+
+/// The 4 permutations of `(a, a, a, 1 − 3a)`.
+fn orbit_s31(a: f64) -> [[f64; 4]; 4] {
+    let b = 1.0 - 3.0 * a;
+    [[b, a, a, a], [a, b, a, a], [a, a, b, a], [a, a, a, b]]
+}
+
+/// The 6 permutations of `(a, a, ½ − a, ½ − a)`.
+fn orbit_s22(a: f64) -> [[f64; 4]; 6] {
+    let b = 0.5 - a;
+    [
+        [a, a, b, b],
+        [a, b, a, b],
+        [a, b, b, a],
+        [b, a, a, b],
+        [b, a, b, a],
+        [b, b, a, a],
+    ]
+}
+
+/// A symmetric rule on the unit tetrahedron exact for every polynomial of total degree
+/// `≤ degree` (the smallest tabulated one), weights summing to 1/6, all positive:
+///
+/// * degree ≤ 1: the centroid, 1 point;
+/// * degree 2: 4 points `(a, a, a, 1 − 3a)`, `a = (5 − √5)/20`, weights 1/24;
+/// * degree 3 to 5: 14 points (two 4-point orbits and one 6-point orbit; Walkington's
+///   degree-5 rule, the one Gmsh uses for "Gauss5").
+///
+/// Panics for a degree above 5 (a programming error: the elements of this crate need ≤ 5).
+pub fn tetrahedron_rule(degree: u32) -> Vec<QuadraturePoint> {
+    let mut out = Vec::new();
+    match degree {
+        0 | 1 => tetrahedron_orbit(&mut out, &[[0.25; 4]], 1.0 / 6.0),
+        2 => {
+            let a = (5.0 - 5f64.sqrt()) / 20.0;
+            tetrahedron_orbit(&mut out, &orbit_s31(a), 1.0 / 24.0);
+        }
+        3..=5 => {
+            tetrahedron_orbit(
+                &mut out,
+                &orbit_s31(0.092_735_250_310_891_22),
+                0.012_248_840_519_393_659,
+            );
+            tetrahedron_orbit(
+                &mut out,
+                &orbit_s31(0.310_885_919_263_300_6),
+                0.018_781_320_953_002_643,
+            );
+            tetrahedron_orbit(
+                &mut out,
+                &orbit_s22(0.045_503_704_125_649_65),
+                0.007_091_003_462_846_911,
+            );
+        }
+        _ => panic!("tetrahedron_rule: degree {degree} not tabulated (≤ 5)"),
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn factorial(n: u32) -> f64 {
+        (1..=n).map(f64::from).product()
+    }
+
+    /// `∫ ξ^a η^b ζ^c` over the unit tetrahedron `= a! b! c! / (a + b + c + 3)!`.
+    fn tetrahedron_monomial(a: u32, b: u32, c: u32) -> f64 {
+        factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3)
+    }
+
+    #[test]
+    fn tetrahedron_rules_are_exact_to_their_degree_and_not_beyond() {
+        for (degree, points) in [(1, 1), (2, 4), (5, 14)] {
+            let rule = tetrahedron_rule(degree);
+            assert_eq!(rule.len(), points);
+            assert!(rule.iter().all(|q| q.weight > 0.0));
+            assert!(rule
+                .iter()
+                .all(|q| q.xi.iter().all(|&c| c > 0.0) && q.xi.iter().sum::<f64>() < 1.0));
+            let mut worst_beyond = 0.0f64;
+            for a in 0..=degree + 1 {
+                for b in 0..=degree + 1 - a {
+                    for c in 0..=degree + 1 - a - b {
+                        let q: f64 = rule
+                            .iter()
+                            .map(|p| {
+                                p.weight
+                                    * p.xi[0].powi(a as i32)
+                                    * p.xi[1].powi(b as i32)
+                                    * p.xi[2].powi(c as i32)
+                            })
+                            .sum();
+                        let exact = tetrahedron_monomial(a, b, c);
+                        let error = (q - exact).abs() / exact;
+                        if a + b + c <= degree {
+                            // Round-off of ≤ 14 terms: a few ε.
+                            assert!(
+                                error < 1e-14,
+                                "degree {degree}: ξ^{a} η^{b} ζ^{c}: {error:e}"
+                            );
+                        } else {
+                            worst_beyond = worst_beyond.max(error);
+                        }
+                    }
+                }
+            }
+            // Some monomial of degree + 1 is not integrated exactly (the rule is no better).
+            assert!(worst_beyond > 1e-4, "degree {degree}: exact beyond?");
+        }
+    }
 
     /// ∫_{−1}^{1} x^k dx = 2/(k+1) for even k, 0 for odd k.
     fn exact_monomial(k: u32) -> f64 {

@@ -389,7 +389,7 @@ pub unsafe extern "C" fn fmi2GetBoolean(
     })
 }
 
-/// `fmi2GetString`: there are no String variables, so any value reference is an error.
+/// `fmi2GetString`: the strings stay valid until the next `fmi2GetString` on this instance.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetString(
     c: fmi2Component,
@@ -400,7 +400,13 @@ pub unsafe extern "C" fn fmi2GetString(
     const F: &str = "fmi2GetString";
     call(c, F, |inst| {
         match (slice_in(vr, nvr), slice_out(value, nvr)) {
-            (Some(vrs), Some(_)) => inst.strings(F, vrs, false),
+            (Some(vrs), Some(out)) => {
+                let (status, strings) = inst.get_strings(F, vrs);
+                for (o, s) in out.iter_mut().zip(strings) {
+                    *o = s.as_ptr();
+                }
+                status
+            }
             _ => inst.fail(F, &null_arrays(nvr)),
         }
     })
@@ -460,7 +466,7 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     })
 }
 
-/// `fmi2SetString`: there are no String variables, so any value reference is an error.
+/// `fmi2SetString`: the strings are copied (lossy UTF-8).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetString(
     c: fmi2Component,
@@ -471,7 +477,10 @@ pub unsafe extern "C" fn fmi2SetString(
     const F: &str = "fmi2SetString";
     call(c, F, |inst| {
         match (slice_in(vr, nvr), slice_in(value, nvr)) {
-            (Some(vrs), Some(_)) => inst.strings(F, vrs, true),
+            (Some(vrs), Some(values)) => {
+                let copies: Vec<Option<String>> = values.iter().map(|&p| copy_string(p)).collect();
+                inst.set_strings(F, vrs, &copies)
+            }
             _ => inst.fail(F, &null_arrays(nvr)),
         }
     })

@@ -52,6 +52,19 @@ pub trait CoSimSlave {
     fn set_integer(&mut self, vr: u32, value: i32) -> Result<()>;
     fn get_boolean(&mut self, vr: u32) -> Result<bool>;
     fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()>;
+    /// Value of a String variable (default: there are none).
+    fn get_string(&mut self, vr: u32) -> Result<String> {
+        Err(crate::Error::new(format!(
+            "no String variable has value reference {vr}"
+        )))
+    }
+    /// Sets a String parameter (default: there are none).
+    fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        let _ = value;
+        Err(crate::Error::new(format!(
+            "no String variable has value reference {vr}"
+        )))
+    }
     fn do_step(
         &mut self,
         current_communication_point: f64,
@@ -125,6 +138,12 @@ impl CoSimSlave for Slave {
     }
     fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
         Slave::set_boolean(self, vr, value)
+    }
+    fn get_string(&mut self, vr: u32) -> Result<String> {
+        Slave::get_string(self, vr)
+    }
+    fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        Slave::set_string(self, vr, value)
     }
     fn do_step(&mut self, t: f64, h: f64) -> Result<()> {
         Slave::do_step(self, t, h)
@@ -297,6 +316,8 @@ pub struct Instance<S: CoSimSlave> {
     state: MachineState,
     /// Set by a discarded step: `fmi2GetBooleanStatus(fmi2Terminated)` answers true.
     terminate_requested: bool,
+    /// The strings of the last `fmi2GetString` (valid until the next call on this instance).
+    strings: Vec<std::ffi::CString>,
 }
 
 /// What a value getter returns for the C side.
@@ -373,6 +394,7 @@ fn type_name(ty: VariableType) -> &'static str {
         VariableType::Real => "Real",
         VariableType::Integer => "Integer",
         VariableType::Boolean => "Boolean",
+        VariableType::String => "String",
     }
 }
 
@@ -406,6 +428,7 @@ impl<S: CoSimSlave> Instance<S> {
             logger,
             state: M::Instantiated,
             terminate_requested: false,
+            strings: Vec::new(),
         }
     }
 
@@ -624,6 +647,7 @@ impl<S: CoSimSlave> Instance<S> {
                 VariableType::Real,
                 VariableType::Integer,
                 VariableType::Boolean,
+                VariableType::String,
             ]
             .into_iter()
             .find_map(|t| table.get(t, vr));
@@ -703,19 +727,76 @@ impl<S: CoSimSlave> Instance<S> {
         fmi2Status::fmi2OK
     }
 
-    /// `fmi2GetString` / `fmi2SetString`: the FMU has no String variables, so any value reference
-    /// is an error (an empty request is fine).
-    pub fn strings(&mut self, function: &str, vrs: &[u32], allowed_for_set: bool) -> fmi2Status {
-        if let Err(s) = self.check_state(function, if allowed_for_set { SET } else { GET }) {
+    /// `fmi2GetString`: the values of `vrs`, kept in the instance until its next
+    /// `fmi2GetString` (the caller hands out pointers into them). A value with a NUL byte is
+    /// refused.
+    pub fn get_strings(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+    ) -> (fmi2Status, &[std::ffi::CString]) {
+        if let Err(s) = self.check_state(function, GET) {
+            return (s, &[]);
+        }
+        let mut values = Vec::with_capacity(vrs.len());
+        for &vr in vrs {
+            if let Err(e) = self.lookup(VariableType::String, vr) {
+                return (self.fail(function, &e), &[]);
+            }
+            match self.slave.get_string(vr) {
+                Ok(text) => match std::ffi::CString::new(text) {
+                    Ok(c) => values.push(c),
+                    Err(_) => {
+                        let status = self.fail(
+                            function,
+                            &format!("String value reference {vr} holds a NUL character"),
+                        );
+                        return (status, &[]);
+                    }
+                },
+                Err(e) => return (self.report(function, &e), &[]),
+            }
+        }
+        self.strings = values;
+        (fmi2Status::fmi2OK, &self.strings)
+    }
+
+    /// `fmi2SetString`: like [`Self::set_values`]; a NULL string (None) is an error naming the
+    /// variable.
+    pub fn set_strings(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &[Option<String>],
+    ) -> fmi2Status {
+        debug_assert_eq!(vrs.len(), values.len());
+        if let Err(s) = self.check_state(function, SET) {
             return s;
         }
-        match vrs.first() {
-            None => fmi2Status::fmi2OK,
-            Some(vr) => self.fail(
-                function,
-                &format!("unknown String value reference {vr} (this FMU has no String variables)"),
-            ),
+        for (&vr, value) in vrs.iter().zip(values) {
+            let reason = match self.lookup(VariableType::String, vr) {
+                Ok(v) => settability_violation(self.state, v)
+                    .map(|r| format!("{r} (value reference {vr}, state {:?})", self.state))
+                    .or_else(|| {
+                        value
+                            .is_none()
+                            .then(|| format!("{} = NULL rejected: not a string", v.name))
+                    }),
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(function, &reason);
+            }
         }
+        for (&vr, value) in vrs.iter().zip(values) {
+            if let Err(e) = self
+                .slave
+                .set_string(vr, value.as_deref().unwrap_or_default())
+            {
+                return self.report(function, &e);
+            }
+        }
+        fmi2Status::fmi2OK
     }
 
     /// `fmi2DoStep`: `h` must be finite and > 0; the slave checks `t` against its time. A
@@ -1492,9 +1573,16 @@ mod tests {
         assert!(last_message(&log).contains("not a Boolean variable"));
         assert_eq!(i.set_values("fmi2SetInteger", &[12345], &[1]), ERR);
         assert!(last_message(&log).contains("unknown Integer value reference 12345"));
-        assert_eq!(i.strings("fmi2GetString", &[], false), OK);
-        assert_eq!(i.strings("fmi2GetString", &[YOUNG], false), ERR);
-        assert!(last_message(&log).contains("unknown String value reference 1"));
+        assert_eq!(i.get_strings("fmi2GetString", &[]).0, OK);
+        assert_eq!(i.get_strings("fmi2GetString", &[YOUNG]).0, ERR);
+        assert!(last_message(&log).contains("not a String variable"));
+        assert_eq!(
+            i.set_strings("fmi2SetString", &[YOUNG], &[Some("x".into())]),
+            ERR
+        );
+        assert!(last_message(&log).contains("not a String variable"));
+        assert_eq!(i.get_strings("fmi2GetString", &[12345]).0, ERR);
+        assert!(last_message(&log).contains("unknown String value reference 12345"));
         assert_eq!(i.state(), M::StepComplete);
     }
 

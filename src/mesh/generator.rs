@@ -2,15 +2,29 @@
 
 use super::{ElementKind, Mesh};
 use crate::error::{Error, Result};
-use crate::fem::element::natural_coordinates;
+use crate::fem::element::{natural_coordinates, TET_EDGES};
+
+/// The 6 permutations of the axes: tetrahedron `p` of the Kuhn subdivision of the unit cube runs
+/// from corner `(0,0,0)` along `e_{π0}`, then `e_{π1}`, then `e_{π2}` to `(1,1,1)`.
+const KUHN_PERMUTATIONS: [[usize; 3]; 6] = [
+    [0, 1, 2],
+    [1, 2, 0],
+    [2, 0, 1],
+    [0, 2, 1],
+    [2, 1, 0],
+    [1, 0, 2],
+];
 
 /// A box `[0, length] × [−width/2, width/2] × [−height/2, height/2]` (m) meshed with
-/// `divisions = [nx, ny, nz]` elements of `kind`. The beam axis is x, width along y, height along z.
+/// `divisions = [nx, ny, nz]` cells of `kind`. The beam axis is x, width along y, height along z.
 ///
-/// Nodes lie on a lattice of spacing `(length/nx, width/ny, height/nz)` (Hex8) or half of it
-/// (Hex20: corners at even lattice indices, mid-edge nodes where exactly one index is odd; no
-/// face or body centres). Nodes are numbered with z fastest, then y, then x, so the nodes of one
-/// cross-section are contiguous. Element `(i, j, k)` has index `(i · ny + j) · nz + k`.
+/// Nodes lie on a lattice of spacing `(length/nx, width/ny, height/nz)` (Hex8, Tet4) or half of
+/// it (Hex20: corners at even lattice indices, mid-edge nodes where exactly one index is odd; no
+/// face or body centres; Tet10: every lattice point). Nodes are numbered with z fastest, then y,
+/// then x, so the nodes of one cross-section are contiguous. Cell `(i, j, k)` has index
+/// `c = (i · ny + j) · nz + k`; with hexahedra it is element `c`, with tetrahedra it is split into
+/// the 6 tetrahedra `6c … 6c + 5` of the Kuhn subdivision (all sharing the cell's diagonal from
+/// its corner at lowest x, y, z; conforming between cells).
 pub fn beam(
     length: f64,
     width: f64,
@@ -38,19 +52,16 @@ pub fn beam(
             "every division count must be at least 1",
         ));
     }
-    // Lattice points per element edge minus one: 1 (Hex8) or 2 (Hex20).
-    let step = match kind {
-        ElementKind::Hex8 => 1,
-        ElementKind::Hex20 => 2,
-    };
+    // Lattice points per element edge minus one: 1 (linear) or 2 (quadratic).
+    let step = if kind.is_quadratic() { 2 } else { 1 };
     let lattice = [
         step * divisions[0] + 1,
         step * divisions[1] + 1,
         step * divisions[2] + 1,
     ];
     let is_node = |i: usize, j: usize, k: usize| match kind {
-        ElementKind::Hex8 => true,
         ElementKind::Hex20 => (i % 2) + (j % 2) + (k % 2) <= 1,
+        _ => true,
     };
     let origin = [0.0, -0.5 * width, -0.5 * height];
     let spacing = [
@@ -80,11 +91,52 @@ pub fn beam(
         }
     }
     let natural = natural_coordinates(kind);
-    let mut connectivity =
-        Vec::with_capacity(divisions[0] * divisions[1] * divisions[2] * kind.node_count());
+    let per_cell = match kind {
+        ElementKind::Hex8 | ElementKind::Hex20 => 1,
+        ElementKind::Tet4 | ElementKind::Tet10 => 6,
+    };
+    let mut connectivity = Vec::with_capacity(
+        divisions[0] * divisions[1] * divisions[2] * per_cell * kind.node_count(),
+    );
     for i in 0..divisions[0] {
         for j in 0..divisions[1] {
             for k in 0..divisions[2] {
+                if per_cell == 6 {
+                    for permutation in KUHN_PERMUTATIONS {
+                        // Corners in lattice steps of the cell (0 or `step`).
+                        let mut corners = [[0usize; 3]; 4];
+                        for v in 1..4 {
+                            corners[v] = corners[v - 1];
+                            corners[v][permutation[v - 1]] = step;
+                        }
+                        // The volume has the sign of the permutation: swap two corners of the
+                        // odd ones (an odd number of inversions).
+                        let p = permutation;
+                        let inversions = usize::from(p[0] > p[1])
+                            + usize::from(p[0] > p[2])
+                            + usize::from(p[1] > p[2]);
+                        if inversions % 2 == 1 {
+                            corners.swap(1, 2);
+                        }
+                        let node_at = |l: [usize; 3]| {
+                            let node =
+                                index[flat(step * i + l[0], step * j + l[1], step * k + l[2])];
+                            debug_assert_ne!(node, usize::MAX);
+                            node
+                        };
+                        for c in &corners {
+                            connectivity.push(node_at(*c));
+                        }
+                        if kind == ElementKind::Tet10 {
+                            for (a, b, _) in TET_EDGES {
+                                let mid =
+                                    std::array::from_fn(|d| (corners[a][d] + corners[b][d]) / 2);
+                                connectivity.push(node_at(mid));
+                            }
+                        }
+                    }
+                    continue;
+                }
                 for xi in natural {
                     // Natural coordinate −1, 0, 1 ↦ lattice offset 0, step/2, step.
                     let offset = |c: f64| ((c + 1.0) * 0.5 * step as f64).round() as usize;
@@ -132,6 +184,65 @@ mod tests {
                 let x = m.nodes()[m.element(0)[a]];
                 let expected = [1.0 + xi[0], 0.5 * xi[1], 2.0 * xi[2]];
                 assert_eq!(x, expected, "{kind:?} local node {a}");
+            }
+        }
+    }
+
+    #[test]
+    fn tetrahedra_fill_the_box_conformingly() {
+        use crate::fem::element::{mass_rule, physical_gradients, shape_functions, MAX_NODES};
+        for (kind, lattice) in [
+            (ElementKind::Tet4, [4, 3, 4]),
+            (ElementKind::Tet10, [7, 5, 7]),
+        ] {
+            let m = beam(1.5, 0.1, 0.2, [3, 2, 3], kind).unwrap();
+            // Every lattice point is a node (Tet10 uses all mid-edge and diagonal midpoints).
+            assert_eq!(
+                m.node_count(),
+                lattice.iter().product::<usize>(),
+                "{kind:?}"
+            );
+            assert_eq!(m.element_count(), 6 * 18);
+            // Positive volumes (Mesh::new checked det J) that add up to the box.
+            let n = kind.node_count();
+            let mut volume = 0.0;
+            let (mut v, mut d, mut g) = (
+                [0.0; MAX_NODES],
+                [[0.0; 3]; MAX_NODES],
+                [[0.0; 3]; MAX_NODES],
+            );
+            for e in 0..m.element_count() {
+                let coords: Vec<[f64; 3]> = m.element(e).iter().map(|&i| m.nodes()[i]).collect();
+                for q in mass_rule(kind) {
+                    shape_functions(kind, q.xi, &mut v, &mut d);
+                    volume += q.weight * physical_gradients(&coords, &d[..n], &mut g[..n]);
+                }
+            }
+            assert!(
+                (volume / (1.5 * 0.1 * 0.2) - 1.0).abs() < 1e-13,
+                "{kind:?}: {volume}"
+            );
+            // Conforming: every triangular face is shared by two elements or lies on the boundary.
+            let mut faces = std::collections::HashMap::new();
+            for e in 0..m.element_count() {
+                let c = &m.element(e)[..4];
+                for skip in 0..4 {
+                    let mut f: Vec<usize> = (0..4).filter(|&k| k != skip).map(|k| c[k]).collect();
+                    f.sort_unstable();
+                    *faces.entry(f).or_insert(0) += 1;
+                }
+            }
+            let (lo, hi) = m.bounding_box();
+            for (f, count) in faces {
+                let on_boundary = (0..3).any(|d| {
+                    f.iter().all(|&i| m.nodes()[i][d] == lo[d])
+                        || f.iter().all(|&i| m.nodes()[i][d] == hi[d])
+                });
+                assert_eq!(
+                    count,
+                    if on_boundary { 1 } else { 2 },
+                    "{kind:?} face {f:?}"
+                );
             }
         }
     }

@@ -1,6 +1,7 @@
 //! Meshes of 3D solids: nodes, elements of one kind, validation, generators and node selectors.
 
 pub mod generator;
+pub mod gmsh;
 pub mod selector;
 
 pub use generator::beam;
@@ -8,6 +9,7 @@ pub use selector::NodeSelector;
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// The element kinds the finite elements of [`crate::fem`] know.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -17,28 +19,47 @@ pub enum ElementKind {
     Hex8,
     /// 20-node serendipity hexahedron (VTK_QUADRATIC_HEXAHEDRON node order).
     Hex20,
+    /// 4-node linear tetrahedron (VTK_TETRA node order).
+    Tet4,
+    /// 10-node quadratic tetrahedron (VTK_QUADRATIC_TETRA node order).
+    Tet10,
 }
 
 impl ElementKind {
     /// Every element kind.
-    pub const ALL: [ElementKind; 2] = [ElementKind::Hex8, ElementKind::Hex20];
+    pub const ALL: [ElementKind; 4] = [
+        ElementKind::Hex8,
+        ElementKind::Hex20,
+        ElementKind::Tet4,
+        ElementKind::Tet10,
+    ];
 
     /// Nodes per element.
     pub fn node_count(self) -> usize {
         match self {
             ElementKind::Hex8 => 8,
             ElementKind::Hex20 => 20,
+            ElementKind::Tet4 => 4,
+            ElementKind::Tet10 => 10,
         }
+    }
+
+    /// Whether the shape functions are quadratic (mid-edge nodes: Hex20, Tet10).
+    pub fn is_quadratic(self) -> bool {
+        matches!(self, ElementKind::Hex20 | ElementKind::Tet10)
     }
 }
 
-/// A validated mesh: reference node positions `X` (m) and the connectivity of elements of one kind.
+/// A validated mesh: reference node positions `X` (m), the connectivity of elements of one kind
+/// and named node sets (the physical groups of an imported mesh).
 #[derive(Debug, Clone)]
 pub struct Mesh {
     nodes: Vec<[f64; 3]>,
     kind: ElementKind,
     /// `kind.node_count()` node indices per element, flat.
     connectivity: Vec<usize>,
+    /// Named node sets: ascending, unique node indices.
+    groups: BTreeMap<String, Vec<usize>>,
 }
 
 impl Mesh {
@@ -47,8 +68,9 @@ impl Mesh {
     /// the error names the element.
     ///
     /// "Degenerate" means `det J ≤ 1e-12 · (h/2)³` somewhere, with `h` the largest distance between
-    /// two nodes of the element (`(h/2)³` is the size of `det J` of a cube of edge `h`): the checks
-    /// run at the points of the full integration rule and at the element's nodes.
+    /// two nodes of the element (`(h/2)³` is the size of `det J` of a cube of edge `h`; a regular
+    /// tetrahedron of edge `h` has `det J = h³/√2`): the checks run at the points of the mass
+    /// rule (the richest rule of each kind) and at the element's nodes.
     pub fn new(nodes: Vec<[f64; 3]>, kind: ElementKind, connectivity: Vec<usize>) -> Result<Mesh> {
         let per_element = kind.node_count();
         if nodes.is_empty() {
@@ -101,24 +123,50 @@ impl Mesh {
             nodes,
             kind,
             connectivity,
+            groups: BTreeMap::new(),
         };
         mesh.check_jacobians()?;
         Ok(mesh)
     }
 
+    /// The mesh with named node sets (node indices in any order, repeats allowed); an index out of
+    /// range or an empty set is an error naming the group.
+    pub fn with_groups(mut self, groups: BTreeMap<String, Vec<usize>>) -> Result<Mesh> {
+        for (name, mut nodes) in groups {
+            nodes.sort_unstable();
+            nodes.dedup();
+            if nodes.is_empty() {
+                return Err(Error::new(format!("mesh: node group '{name}' is empty")));
+            }
+            if let Some(&bad) = nodes.iter().find(|&&i| i >= self.nodes.len()) {
+                return Err(Error::new(format!(
+                    "mesh: node group '{name}' refers to node {bad}, but the mesh has {} nodes",
+                    self.nodes.len()
+                )));
+            }
+            self.groups.insert(name, nodes);
+        }
+        Ok(self)
+    }
+
+    /// The nodes of the named group (ascending), if there is one.
+    pub fn group(&self, name: &str) -> Option<&[usize]> {
+        self.groups.get(name).map(Vec::as_slice)
+    }
+
+    /// The names of the node groups, sorted.
+    pub fn group_names(&self) -> impl Iterator<Item = &str> {
+        self.groups.keys().map(String::as_str)
+    }
+
     /// The Jacobian determinant check of [`Mesh::new`].
     fn check_jacobians(&self) -> Result<()> {
         use crate::fem::element::{
-            full_integration_points, natural_coordinates, physical_gradients, shape_functions,
-            MAX_NODES,
+            mass_rule, natural_coordinates, physical_gradients, shape_functions, MAX_NODES,
         };
-        use crate::fem::quadrature::hexahedron_rule;
         let kind = self.kind;
         let n = kind.node_count();
-        let mut points: Vec<[f64; 3]> = hexahedron_rule(full_integration_points(kind))
-            .iter()
-            .map(|q| q.xi)
-            .collect();
+        let mut points: Vec<[f64; 3]> = mass_rule(kind).iter().map(|q| q.xi).collect();
         points.extend_from_slice(natural_coordinates(kind));
         // Natural derivatives at every check point, computed once.
         let mut values = [0.0; MAX_NODES];

@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 /// mesh's bounding box (m) absorbs round-off in generated or imported coordinates.
 pub const RELATIVE_TOLERANCE: f64 = 1e-9;
 
-/// A rule selecting nodes of a mesh (body file: `{ "box": { "min": [..], "max": [..] } }` or
-/// `{ "plane": { "point": [..], "normal": [..], "tolerance": 1e-9 } }`).
+/// A rule selecting nodes of a mesh (body file: `{ "box": { "min": [..], "max": [..] } }`,
+/// `{ "plane": { "point": [..], "normal": [..], "tolerance": 1e-9 } }` or `{ "group": "name" }`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]
 pub enum NodeSelector {
@@ -24,6 +24,9 @@ pub enum NodeSelector {
         #[serde(default)]
         tolerance: Option<f64>,
     },
+    /// The nodes of a named group of the mesh: a physical group of a Gmsh mesh (its elements'
+    /// nodes, see [`crate::mesh::gmsh`]).
+    Group(String),
 }
 
 impl NodeSelector {
@@ -82,6 +85,22 @@ impl NodeSelector {
                     .map(|(i, _)| i)
                     .collect()
             }
+            NodeSelector::Group(name) => match mesh.group(name) {
+                Some(nodes) => nodes.to_vec(),
+                None => {
+                    let names: Vec<&str> = mesh.group_names().collect();
+                    let known = if names.is_empty() {
+                        "the mesh has no groups (only imported Gmsh meshes have physical groups)"
+                            .to_string()
+                    } else {
+                        format!("its groups are: {}", names.join(", "))
+                    };
+                    return Err(Error::new(format!(
+                        "node selector {}: the mesh has no group '{name}'; {known}",
+                        self.describe()
+                    )));
+                }
+            },
         };
         if selected.is_empty() {
             return Err(Error::new(format!(

@@ -3,8 +3,9 @@
 //! clamped steel cantilever with a force interface `tip`) is embedded in the binary.
 
 use crate::error::{Error, Result};
-use crate::mesh::{ElementKind, NodeSelector};
+use crate::mesh::{ElementKind, Mesh, NodeSelector};
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// The embedded default body.
 pub const DEFAULT_BODY_JSON: &str = include_str!("../../examples/cantilever.json");
@@ -45,6 +46,41 @@ pub enum MeshSpec {
         divisions: [usize; 3],
         element: ElementKind,
     },
+    /// A Gmsh mesh file (MSH 4.1, ASCII or binary; see [`crate::mesh::gmsh`]): `file` relative to
+    /// the body file's directory (in an FMU: `resources/`), coordinates multiplied by `scale`.
+    Gmsh {
+        file: String,
+        #[serde(default = "MeshSpec::default_scale")]
+        scale: f64,
+    },
+}
+
+impl MeshSpec {
+    fn default_scale() -> f64 {
+        1.0
+    }
+
+    /// Builds the mesh; a relative mesh file is looked up in `base_dir` (the directory of the body
+    /// file; `None`: the current directory).
+    pub fn build(&self, base_dir: Option<&Path>) -> Result<Mesh> {
+        match self {
+            MeshSpec::Beam {
+                length,
+                width,
+                height,
+                divisions,
+                element,
+            } => crate::mesh::beam(*length, *width, *height, *divisions, *element),
+            MeshSpec::Gmsh { file, scale } => {
+                let path = match base_dir {
+                    Some(dir) => dir.join(file),
+                    None => Path::new(file).to_path_buf(),
+                };
+                crate::mesh::gmsh::read(&path, *scale)
+                    .map_err(|e| Error::new(format!("mesh.gmsh: {}", e.message)))
+            }
+        }
+    }
 }
 
 /// Material defaults (the FMU's `material.*` parameters start here).

@@ -261,6 +261,7 @@ pub fn model_description(
                 }
             }
             VariableType::Boolean => x.push_str("Boolean"),
+            VariableType::String => x.push_str("String"),
         }
         if has_start {
             let _ = write!(x, " start=\"{}\"", a(&start(v)));
@@ -412,6 +413,7 @@ mod tests {
             VariableType::Real => format_real(0.1 + v.value_reference as f64 / 3.0),
             VariableType::Integer => v.value_reference.to_string(),
             VariableType::Boolean => "false".into(),
+            VariableType::String => format!("text & <{}>", v.value_reference),
         }
     }
 
@@ -558,6 +560,7 @@ mod tests {
                     }
                     None => assert_eq!(typed.name, "Integer"),
                 },
+                VariableType::String => assert_eq!(typed.name, "String"),
                 VariableType::Boolean => {
                     assert_eq!(typed.name, "Boolean");
                     if v.causality != Causality::Output {

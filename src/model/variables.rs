@@ -11,6 +11,7 @@ pub enum VariableType {
     Real,
     Integer,
     Boolean,
+    String,
 }
 
 /// FMI 2.0 causality (the ones this FMU uses).

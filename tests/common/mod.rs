@@ -25,6 +25,7 @@ pub fn set(slave: &mut Slave, name: &str, value: f64) {
         VariableType::Real => slave.set_real(v.value_reference, value).unwrap(),
         VariableType::Integer => slave.set_integer(v.value_reference, value as i32).unwrap(),
         VariableType::Boolean => slave.set_boolean(v.value_reference, value != 0.0).unwrap(),
+        VariableType::String => panic!("{name} is a String: use Slave::set_string"),
     }
 }
 
@@ -74,4 +75,9 @@ pub fn b3_step(slave: &mut Slave, t: f64, h: f64) -> f64 {
     let q1 = Rotation3::from_axis_angle(&Vector3::z_axis(), b3::hub(t + h).0);
     let tip = Vector3::from_fn(|c, _| get(slave, &format!("tip.position[{}]", c + 1)));
     (q1.inverse() * tip).y
+}
+
+/// The body file at `path`.
+pub fn example_body_at(path: &std::path::Path) -> BodyFile {
+    BodyFile::from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
 }

@@ -61,3 +61,10 @@ def driven_model_description(driven_fmu_path):
 @pytest.fixture(scope="session")
 def driven_unzipdir(driven_fmu_path, tmp_path_factory) -> str:
     return extract(driven_fmu_path, unzipdir=str(tmp_path_factory.mktemp("driven_fmu")))
+
+
+@pytest.fixture(scope="session")
+def conrod_fmu_path() -> str:
+    """The connecting rod: a Gmsh tet10 mesh in resources/, big eye a motion interface, small eye a force
+    interface (examples/conrod.json)."""
+    return _packaged_fmu("FLEXBODY_CONROD_FMU", "conrod.fmu", "cargo xtask fmu --body examples/conrod.json")

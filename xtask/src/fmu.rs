@@ -4,6 +4,9 @@
 //! modelDescription.xml                           from `flexbody-model-description --body FILE`
 //! binaries/<platform>/<modelIdentifier>.<ext>    the release cdylib, renamed (linux64: .so)
 //! resources/body.json                            the body file, byte for byte
+//! resources/<mesh file>                          a Gmsh mesh the body file names ("mesh":
+//!                                                { "gmsh": { "file": ... } }), at the same
+//!                                                path relative to body.json
 //! ```
 //!
 //! The shared library's name is taken from the `modelIdentifier` attribute of the generated XML,
@@ -92,6 +95,7 @@ pub fn package(
             .arg(body),
     )?;
     let model_identifier = model_identifier(&xml)?;
+    let resources = mesh_resources(&body_text, body.parent().unwrap_or(Path::new(".")))?;
     let out = match out {
         Some(path) => path.to_path_buf(),
         None => workspace
@@ -105,8 +109,42 @@ pub fn package(
         &model_identifier,
         &artifacts.library,
         body_text.as_bytes(),
+        &resources,
     )?;
     Ok(out)
+}
+
+/// The mesh file a body file names (`mesh.gmsh.file`), as (path inside `resources/`, bytes).
+/// The path must be relative and stay inside the body file's directory, so that the FMU can
+/// hold it at the same place relative to `resources/body.json` and the body file stays as it is.
+fn mesh_resources(body_json: &str, body_dir: &Path) -> Result<Vec<(String, Vec<u8>)>> {
+    let body: serde_json::Value =
+        serde_json::from_str(body_json).map_err(|e| format!("body file: {e}"))?;
+    let Some(file) = body["mesh"]["gmsh"]["file"].as_str() else {
+        return Ok(Vec::new());
+    };
+    let relative = Path::new(file);
+    let mut parts = Vec::new();
+    for component in relative.components() {
+        match component {
+            std::path::Component::Normal(part) => parts.push(
+                part.to_str()
+                    .ok_or_else(|| format!("mesh file '{file}': not UTF-8"))?
+                    .to_string(),
+            ),
+            _ => {
+                return Err(format!(
+                    "mesh file '{file}': must be a relative path inside the body file's                      directory (no '..', no absolute path) to be packaged into resources/"
+                ))
+            }
+        }
+    }
+    if parts.is_empty() || parts.last().is_some_and(|p| p == "body.json") {
+        return Err(format!("mesh file '{file}': not a usable file name"));
+    }
+    let path = body_dir.join(relative);
+    let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    Ok(vec![(format!("resources/{}", parts.join("/")), bytes)])
 }
 
 /// The FMI platform folder and library extension of the machine this xtask was built for.
@@ -130,6 +168,7 @@ fn write_fmu(
     model_identifier: &str,
     library: &Path,
     body_json: &[u8],
+    resources: &[(String, Vec<u8>)],
 ) -> Result<()> {
     let (platform, extension) = platform()?;
     let library_bytes =
@@ -139,7 +178,7 @@ fn write_fmu(
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
     let partial = out.with_extension("fmu.partial");
-    let entries: [(String, &[u8], u32); 3] = [
+    let mut entries: Vec<(String, &[u8], u32)> = vec![
         ("modelDescription.xml".into(), xml.as_bytes(), 0o644),
         (
             format!("binaries/{platform}/{model_identifier}.{extension}"),
@@ -148,6 +187,9 @@ fn write_fmu(
         ),
         ("resources/body.json".into(), body_json, 0o644),
     ];
+    for (name, bytes) in resources {
+        entries.push((name.clone(), bytes, 0o644));
+    }
     let write = || -> std::io::Result<()> {
         let mut zip = ZipWriter::new(BufWriter::new(File::create(&partial)?));
         for (name, bytes, mode) in entries {
@@ -278,6 +320,26 @@ mod tests {
         assert!(artifacts_from_messages(r#"{"reason":"build-finished","success":true}"#).is_err());
     }
 
+    #[test]
+    fn the_mesh_file_of_a_body_goes_into_resources() {
+        let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+        let conrod = std::fs::read_to_string(examples.join("conrod.json")).unwrap();
+        let resources = mesh_resources(&conrod, &examples).unwrap();
+        assert_eq!(resources.len(), 1);
+        assert_eq!(resources[0].0, "resources/conrod/conrod.msh");
+        assert!(resources[0].1.starts_with(b"$MeshFormat"));
+        let beam = std::fs::read_to_string(examples.join("cantilever.json")).unwrap();
+        assert!(mesh_resources(&beam, &examples).unwrap().is_empty());
+        let outside = r#"{"mesh": {"gmsh": {"file": "../x.msh"}}}"#;
+        assert!(mesh_resources(outside, &examples)
+            .unwrap_err()
+            .contains("no '..'"));
+        let missing = r#"{"mesh": {"gmsh": {"file": "nowhere.msh"}}}"#;
+        assert!(mesh_resources(missing, &examples)
+            .unwrap_err()
+            .contains("cannot read"));
+    }
+
     #[cfg(target_os = "linux")]
     #[test]
     fn fmu_has_the_fmi_layout() {
@@ -293,6 +355,7 @@ mod tests {
             "flexbody",
             &library,
             b"{\"name\":\"cantilever\"}",
+            &[("resources/meshes/part.msh".into(), b"$MeshFormat".to_vec())],
         )
         .unwrap();
         assert!(!out.with_extension("fmu.partial").exists());
@@ -305,7 +368,8 @@ mod tests {
             [
                 "binaries/linux64/flexbody.so",
                 "modelDescription.xml",
-                "resources/body.json"
+                "resources/body.json",
+                "resources/meshes/part.msh"
             ]
         );
         let mut read = |name: &str| {
@@ -319,6 +383,7 @@ mod tests {
         assert_eq!(library_bytes, b"\x7fELF not really");
         assert_eq!(mode.map(|m| m & 0o777), Some(0o755));
         assert_eq!(read("resources/body.json").0, b"{\"name\":\"cantilever\"}");
+        assert_eq!(read("resources/meshes/part.msh").0, b"$MeshFormat");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -6,7 +6,7 @@
 //! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), then the
 //!   default FMU, the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
 //!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
-//!   `FLEXBODY_FMU` and `FLEXBODY_DRIVEN_FMU`.
+//!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU` and `FLEXBODY_CONROD_FMU` (`examples/conrod.json`).
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
@@ -118,6 +118,7 @@ fn test_task(args: &[String]) -> Result<()> {
     let fmu = workspace.build_fmu(None, None)?;
     // The second release build is a no-op: only the packaging differs.
     let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None)?;
+    let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None)?;
     let python = venv::ensure(&workspace)?;
     println!(
         "xtask test: Python tests (pytest tests/python) on {} and {}",
@@ -131,6 +132,7 @@ fn test_task(args: &[String]) -> Result<()> {
         .args(pytest_args)
         .env("FLEXBODY_FMU", &fmu)
         .env("FLEXBODY_DRIVEN_FMU", &driven_fmu)
+        .env("FLEXBODY_CONROD_FMU", &conrod_fmu)
         .env("MPLBACKEND", "Agg");
     run(&mut pytest)
 }
@@ -223,6 +225,11 @@ impl Workspace {
     /// The driven cantilever (root clamped to an input frame): the coupling tests' second body.
     pub fn driven_body(&self) -> PathBuf {
         self.root.join("examples").join("driven_cantilever.json")
+    }
+
+    /// The connecting rod (Gmsh tet10 mesh in resources/, motion and force interfaces on its eyes).
+    pub fn conrod_body(&self) -> PathBuf {
+        self.root.join("examples").join("conrod.json")
     }
 
     /// Builds and packages the FMU; returns its path.
