@@ -349,6 +349,17 @@ mod tests {
     }
 
     #[test]
+    fn gauss_point_count_is_that_of_the_stiffness_rule() {
+        for kind in ElementKind::ALL {
+            assert_eq!(
+                gauss_points_per_element(kind),
+                integration_rule(kind).len(),
+                "{kind:?}"
+            );
+        }
+    }
+
+    #[test]
     fn pattern_is_that_of_the_stiffness_matrix() {
         for kind in ElementKind::ALL {
             let mesh = distorted_block(kind);

@@ -269,7 +269,14 @@ impl BodyFile {
             }
             if matches!(
                 i.name.as_str(),
-                "body" | "material" | "damping" | "gravity" | "initial" | "solver" | "model"
+                "body"
+                    | "material"
+                    | "damping"
+                    | "gravity"
+                    | "initial"
+                    | "solver"
+                    | "model"
+                    | "output"
             ) {
                 return Err(Error::new(format!(
                     "body file: interface name '{}' is reserved for the FMU's own variables",
