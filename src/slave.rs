@@ -1371,8 +1371,6 @@ impl Slave {
         let problem = generalized_alpha::StepProblem {
             body,
             free: &model.free,
-            scheme: &model.scheme,
-            settings: &settings,
             loads: &loads,
             prescribe: &prescribe,
         };
@@ -1389,6 +1387,7 @@ impl Slave {
                 None => generalized_alpha::step(
                     &problem,
                     &mut model.matrices[index],
+                    &settings,
                     hs,
                     &mut dynamics.state,
                     &mut model.workspace,

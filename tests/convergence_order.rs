@@ -56,6 +56,24 @@ fn cantilever() -> Cantilever {
     cantilever_of(ElementKind::Hex20).0
 }
 
+impl Cantilever {
+    /// A step's problem under `loads`; no node is prescribed but the clamped root, which never
+    /// moves.
+    fn problem<'a>(&'a self, loads: &'a dyn Fn(&[f64], &mut [f64])) -> StepProblem<'a> {
+        StepProblem {
+            body: &self.body,
+            free: &self.free,
+            loads,
+            prescribe: &|_t: f64, _s: &mut DynamicState| {},
+        }
+    }
+
+    /// Mean y of the tip nodes (m).
+    fn tip_deflection(&self, x: &[f64]) -> f64 {
+        self.tip.iter().map(|&i| x[3 * i + 1]).sum::<f64>() / self.tip.len() as f64
+    }
+}
+
 fn load(c: &Cantilever, t: f64) -> impl Fn(&[f64], &mut [f64]) + '_ {
     let f = -10.0 * (std::f64::consts::PI * t.min(PULSE) / PULSE).sin().powi(2);
     move |_x: &[f64], out: &mut [f64]| {
@@ -99,26 +117,13 @@ fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
         absolute_tolerance: 1e-14,
         max_iterations: 50,
     };
-    let prescribe = |_t: f64, _s: &mut DynamicState| {};
     let mut tip = Vec::new();
     for n in 1..=((2.0 * PULSE / h).round() as usize) {
         let loads = load(c, n as f64 * h);
-        let problem = StepProblem {
-            body: &c.body,
-            free: &c.free,
-            scheme: &scheme,
-            settings: &settings,
-            loads: &loads,
-            prescribe: &prescribe,
-        };
-        generalized_alpha::step(&problem, &mut matrix, h, &mut state, &mut ws).unwrap();
+        let problem = c.problem(&loads);
+        generalized_alpha::step(&problem, &mut matrix, &settings, h, &mut state, &mut ws).unwrap();
         if n % m == 0 {
-            let y: f64 = c
-                .tip
-                .iter()
-                .map(|&i| state.position[3 * i + 1])
-                .sum::<f64>();
-            tip.push(y / c.tip.len() as f64);
+            tip.push(c.tip_deflection(&state.position));
         }
     }
     tip
@@ -212,33 +217,15 @@ fn central_difference_critical_step_matches_the_highest_eigenvalue() {
 fn run_explicit(c: &Cantilever, scheme: &CentralDifference, h: f64) -> Vec<f64> {
     let mut ws = StepWorkspace::new(&c.body, &c.free);
     let mut state = initial_state(c);
-    let settings = IterationSettings {
-        absolute_tolerance: 1e-14,
-        max_iterations: 1,
-    };
-    let gen = GeneralizedAlpha::new(1.0);
-    let prescribe = |_t: f64, _s: &mut DynamicState| {};
     let per_ms = (1e-3 / h).round() as usize;
     let mut tip = Vec::new();
     for n in 1..=(2.0 * PULSE / 1e-3).round() as usize * per_ms {
         // The explicit scheme evaluates the loads at t_{n+1} as well.
         let loads = load(c, n as f64 * h);
-        let problem = StepProblem {
-            body: &c.body,
-            free: &c.free,
-            scheme: &gen,
-            settings: &settings,
-            loads: &loads,
-            prescribe: &prescribe,
-        };
+        let problem = c.problem(&loads);
         scheme.step(&problem, h, &mut state, &mut ws).unwrap();
         if n % per_ms == 0 {
-            let y: f64 = c
-                .tip
-                .iter()
-                .map(|&i| state.position[3 * i + 1])
-                .sum::<f64>();
-            tip.push(y / c.tip.len() as f64);
+            tip.push(c.tip_deflection(&state.position));
         }
     }
     tip
@@ -267,21 +254,8 @@ fn central_difference_is_second_order_and_refuses_an_unstable_step() {
     let mut ws = StepWorkspace::new(&c.body, &c.free);
     let mut state = initial_state(&c);
     let before = state.clone();
-    let settings = IterationSettings {
-        absolute_tolerance: 1e-14,
-        max_iterations: 1,
-    };
-    let gen = GeneralizedAlpha::new(1.0);
     let loads = load(&c, 0.0);
-    let prescribe = |_t: f64, _s: &mut DynamicState| {};
-    let problem = StepProblem {
-        body: &c.body,
-        free: &c.free,
-        scheme: &gen,
-        settings: &settings,
-        loads: &loads,
-        prescribe: &prescribe,
-    };
+    let problem = c.problem(&loads);
     let error = scheme
         .step(&problem, 1.01 * scheme.stable_step(), &mut state, &mut ws)
         .unwrap_err();

@@ -504,20 +504,31 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
             Ok(s) => s,
             Err(status) => return status,
         };
-        let existing = *FMUstate as *mut FmuState;
-        if existing.is_null() {
-            *FMUstate = Box::into_raw(Box::new(snapshot)) as fmi2FMUstate;
-        } else {
-            if !(*existing).is_valid() {
-                return inst.fail(
-                    F,
-                    "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
-                );
-            }
-            *existing = snapshot;
-        }
-        fmi2Status::fmi2OK
+        store_state(inst, F, FMUstate, snapshot)
     })
+}
+
+/// Stores `snapshot` in `*FMUstate` (fmi2GetFMUstate, fmi2DeSerializeFMUstate): a new state when
+/// `*FMUstate` is NULL, else it overwrites the live state `*FMUstate` points to.
+unsafe fn store_state(
+    inst: &mut Component,
+    function: &str,
+    FMUstate: *mut fmi2FMUstate,
+    snapshot: FmuState,
+) -> fmi2Status {
+    let existing = *FMUstate as *mut FmuState;
+    if existing.is_null() {
+        *FMUstate = Box::into_raw(Box::new(snapshot)) as fmi2FMUstate;
+    } else {
+        if !(*existing).is_valid() {
+            return inst.fail(
+                function,
+                "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
+            );
+        }
+        *existing = snapshot;
+    }
+    fmi2Status::fmi2OK
 }
 
 /// `fmi2SetFMUstate`: the state stays valid and can be used again.
@@ -659,19 +670,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
             Ok(s) => s,
             Err(status) => return status,
         };
-        let existing = *FMUstate as *mut FmuState;
-        if existing.is_null() {
-            *FMUstate = Box::into_raw(Box::new(snapshot)) as fmi2FMUstate;
-        } else {
-            if !(*existing).is_valid() {
-                return inst.fail(
-                    F,
-                    "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
-                );
-            }
-            *existing = snapshot;
-        }
-        fmi2Status::fmi2OK
+        store_state(inst, F, FMUstate, snapshot)
     })
 }
 

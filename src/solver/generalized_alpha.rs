@@ -145,6 +145,8 @@ impl FreeNodes {
 /// solve workspace.
 pub struct IterationMatrix {
     pub step_size: f64,
+    /// The scheme whose coefficients `c_m`, `c_d` at `step_size` the matrix holds.
+    pub scheme: GeneralizedAlpha,
     pub factor: SparseCholesky,
     workspace: SolveWorkspace,
     /// `Z = S̄⁻¹ Cᵀ` and the inverse Schur complement when there are point constraints.
@@ -302,6 +304,7 @@ impl IterationMatrix {
             .then(|| NonlinearForceCorrection::new(body, free, &factor, &mut workspace));
         Ok(IterationMatrix {
             step_size: h,
+            scheme: *scheme,
             factor,
             workspace,
             constraint,
@@ -447,14 +450,13 @@ pub fn last_residual(ws: &StepWorkspace) -> &[f64] {
 /// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.
 pub type Prescription<'a> = &'a dyn Fn(f64, &mut DynamicState);
 
-/// What a step needs besides the state: the body, its free nodes and constraints, the scheme, the
-/// iteration settings, the external loads (`loads(x, f_ext)` adds them to a zeroed `f_ext`) and
-/// the prescription of the clamped nodes.
+/// What a step of any scheme needs besides the state: the body, its free nodes and constraints,
+/// the external loads (`loads(x, f_ext)` adds them to a zeroed `f_ext`) and the prescription of
+/// the clamped nodes. (Generalized-α's own scheme lives in its [`IterationMatrix`], its iteration
+/// settings are an argument of [`step`].)
 pub struct StepProblem<'a> {
     pub body: &'a Body,
     pub free: &'a FreeNodes,
-    pub scheme: &'a GeneralizedAlpha,
-    pub settings: &'a IterationSettings,
     pub loads: &'a dyn Fn(&[f64], &mut [f64]),
     pub prescribe: Prescription<'a>,
 }
@@ -465,12 +467,13 @@ pub struct StepProblem<'a> {
 pub fn step(
     problem: &StepProblem,
     matrix: &mut IterationMatrix,
+    settings: &IterationSettings,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
 ) -> Result<StepReport> {
     ws.previous.copy_from(state);
-    let result = iterate(problem, matrix, h, state, ws);
+    let result = iterate(problem, matrix, settings, h, state, ws);
     if result.is_err() {
         state.copy_from(&ws.previous);
     }
@@ -480,6 +483,7 @@ pub fn step(
 fn iterate(
     problem: &StepProblem,
     matrix: &mut IterationMatrix,
+    settings: &IterationSettings,
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
@@ -487,17 +491,16 @@ fn iterate(
     let StepProblem {
         body,
         free,
-        scheme,
-        settings,
         loads,
         prescribe,
     } = *problem;
+    let scheme = matrix.scheme;
     let GeneralizedAlpha {
         alpha_m,
         alpha_f,
         beta,
         gamma,
-    } = *scheme;
+    } = scheme;
     let c_m = scheme.mass_coefficient(h);
     let c_d = scheme.damping_coefficient(h);
     let prev = &ws.previous;
