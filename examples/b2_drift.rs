@@ -8,8 +8,7 @@ use flexbody::slave::Slave;
 use nalgebra::Vector3;
 
 fn get(s: &mut Slave, name: &str) -> f64 {
-    let vr = s.variables().by_name(name).unwrap().value_reference;
-    s.get_real(vr).unwrap()
+    s.get_by_name(name).unwrap()
 }
 
 fn main() {
@@ -30,28 +29,15 @@ fn main() {
         s.enter_initialization_mode().unwrap();
         let w = Vector3::new(0.5, 3.0, 7.0);
         let v = -w.cross(&Vector3::new(0.5, 0.0, 0.0));
-        let set = |s: &mut Slave, name: &str, value: f64| {
-            let vr = s.variables().by_name(name).unwrap().value_reference;
-            s.set_real(vr, value).unwrap();
-        };
+        let set = |s: &mut Slave, name: &str, value: f64| s.set_by_name(name, value).unwrap();
         for k in 0..3 {
             set(&mut s, &format!("initial.angularVelocity[{}]", k + 1), w[k]);
             set(&mut s, &format!("initial.velocity[{}]", k + 1), v[k]);
         }
         set(&mut s, "solver.stepSize", h);
         set(&mut s, "material.youngsModulus", 2.1e8);
-        let b = s
-            .variables()
-            .by_name("model.nonlinearForces")
-            .unwrap()
-            .value_reference;
-        s.set_boolean(b, f_nl).unwrap();
-        let n = s
-            .variables()
-            .by_name("model.frames")
-            .unwrap()
-            .value_reference;
-        s.set_integer(n, frames).unwrap();
+        set(&mut s, "model.nonlinearForces", f64::from(u8::from(f_nl)));
+        set(&mut s, "model.frames", f64::from(frames));
         s.exit_initialization_mode().unwrap();
         let momentum = |s: &mut Slave| {
             Vector3::from_fn(|k, _| get(s, &format!("body.angularMomentum[{}]", k + 1)))

@@ -11,10 +11,10 @@ use flexbody::fem::nonlinear::SvkSolid;
 use flexbody::fem::IsotropicMaterial;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use nalgebra::{Rotation3, Vector3};
+use nalgebra::Vector3;
 #[path = "../tests/common/b3.rs"]
 mod b3;
-use b3::hub;
+use b3::HubDrive;
 
 fn main() {
     let args: Vec<f64> = std::env::args()
@@ -32,24 +32,14 @@ fn main() {
     let mut s = Slave::from_body(body_file).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();
     s.enter_initialization_mode().unwrap();
-    let vr = |s: &Slave, n: &str| s.variables().by_name(n).unwrap().value_reference;
-    s.set_integer(vr(&s, "model.formulation"), 2).unwrap();
-    s.set_real(vr(&s, "solver.stepSize"), h).unwrap();
+    s.set_by_name("model.formulation", 2.0).unwrap();
+    s.set_by_name("solver.stepSize", h).unwrap();
     s.exit_initialization_mode().unwrap();
-    let rotation: Vec<u32> = (1..=9)
-        .map(|k| vr(&s, &format!("hub.rotation[{k}]")))
-        .collect();
-    let rate = vr(&s, "hub.angularVelocity[3]");
+    let drive = HubDrive::new(&s);
     let steps = (t_end / h).round() as usize;
     for k in 0..steps {
         let t = k as f64 * h;
-        let (theta, omega) = hub(t);
-        let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
-        for (c, &r) in rotation.iter().enumerate() {
-            s.set_real(r, q.matrix()[(c / 3, c % 3)]).unwrap();
-        }
-        s.set_real(rate, omega).unwrap();
-        s.do_step(t, h).unwrap();
+        drive.step(&mut s, t, h).unwrap();
     }
     let x = s.dynamic_state().unwrap().position.clone();
     let body = s.body().unwrap();

@@ -5,17 +5,12 @@
 //! Columns: tip deflection in the hub frame (m) at t = 2, 4, 6, 7, 8, 10, 12, 14 s, the peak and
 //! its time, the largest |deflection| after T_s = 15 s, iterations per step and wall time.
 
-use flexbody::model::{BodyFile, VariableType};
+use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use nalgebra::{Rotation3, Vector3};
 use std::time::Instant;
 #[path = "../tests/common/b3.rs"]
 mod b3;
-use b3::hub;
-
-fn vr(s: &Slave, name: &str) -> u32 {
-    s.variables().by_name(name).unwrap().value_reference
-}
+use b3::HubDrive;
 
 /// A row of the table: label, step size and the Integer/Boolean settings.
 type Case = (String, f64, Vec<(&'static str, i32)>);
@@ -32,26 +27,13 @@ fn run(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Result<Run, String>
     let mut s = Slave::from_body(body.clone()).map_err(|e| e.message)?;
     s.setup_experiment(0.0, None, None).map_err(|e| e.message)?;
     s.enter_initialization_mode().map_err(|e| e.message)?;
-    let step = vr(&s, "solver.stepSize");
-    s.set_real(step, h).map_err(|e| e.message)?;
+    s.set_by_name("solver.stepSize", h).map_err(|e| e.message)?;
     for (name, value) in settings {
-        let v = s.variables().by_name(name).unwrap().clone();
-        match v.ty {
-            VariableType::Integer => s.set_integer(v.value_reference, *value),
-            VariableType::Boolean => s.set_boolean(v.value_reference, *value != 0),
-            VariableType::Real => s.set_real(v.value_reference, *value as f64),
-            VariableType::String => Err(flexbody::Error::new(format!("{name} is a String"))),
-        }
-        .map_err(|e| e.message)?;
+        s.set_by_name(name, f64::from(*value))
+            .map_err(|e| e.message)?;
     }
     s.exit_initialization_mode().map_err(|e| e.message)?;
-    let rotation: Vec<u32> = (1..=9)
-        .map(|k| vr(&s, &format!("hub.rotation[{k}]")))
-        .collect();
-    let rate = vr(&s, "hub.angularVelocity[3]");
-    let tip: Vec<u32> = (1..=3)
-        .map(|k| vr(&s, &format!("tip.position[{k}]")))
-        .collect();
+    let drive = HubDrive::new(&s);
     let times = [2.0, 4.0, 6.0, 7.0, 8.0, 10.0, 12.0, 14.0];
     let mut samples = vec![f64::NAN; times.len()];
     let (mut peak, mut late) = ((0.0, 0.0_f64), 0.0_f64);
@@ -59,17 +41,10 @@ fn run(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Result<Run, String>
     let started = Instant::now();
     for k in 0..steps {
         let t = k as f64 * h;
-        let (theta, omega) = hub(t);
-        let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
-        for (c, &r) in rotation.iter().enumerate() {
-            s.set_real(r, q.matrix()[(c / 3, c % 3)]).unwrap();
-        }
-        s.set_real(rate, omega).unwrap();
-        s.do_step(t, h)
+        let y = drive
+            .step(&mut s, t, h)
             .map_err(|e| format!("t = {t}: {}", e.message))?;
         let t1 = t + h;
-        let p = Vector3::from_fn(|c, _| s.get_real(tip[c]).unwrap());
-        let y = (Rotation3::from_axis_angle(&Vector3::z_axis(), hub(t1).0).inverse() * p).y;
         for (j, &ts) in times.iter().enumerate() {
             if (t1 - ts).abs() < 0.5 * h {
                 samples[j] = y;

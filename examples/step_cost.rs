@@ -7,7 +7,7 @@
 //! step, steps per second, iterations per step and the ratio step/solve. The load is B1's: 10 N at
 //! the tip; the pinned variant is the cantilever with its root face on a pin under gravity.
 
-use flexbody::model::{BodyFile, VariableType};
+use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
 use std::time::Instant;
@@ -15,12 +15,6 @@ use std::time::Instant;
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
     v[v.len() / 2]
-}
-
-fn set(s: &mut Slave, name: &str, value: f64) {
-    let v = s.variables().by_name(name).unwrap().clone();
-    assert_eq!(v.ty, VariableType::Real);
-    s.set_real(v.value_reference, value).unwrap();
 }
 
 fn bodies(paths: &[String]) -> Vec<BodyFile> {
@@ -54,10 +48,10 @@ fn main() {
             let mut s = Slave::from_body(body_file.clone()).unwrap();
             s.setup_experiment(0.0, None, None).unwrap();
             s.enter_initialization_mode().unwrap();
-            set(&mut s, "solver.stepSize", h);
-            set(&mut s, "tip.force[2]", -10.0);
+            s.set_by_name("solver.stepSize", h).unwrap();
+            s.set_by_name("tip.force[2]", -10.0).unwrap();
             if body_file.name.starts_with("pinned") {
-                set(&mut s, "gravity[1]", 9.81);
+                s.set_by_name("gravity[1]", 9.81).unwrap();
             }
             s.exit_initialization_mode().unwrap();
 

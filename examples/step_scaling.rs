@@ -12,7 +12,7 @@
 //! `elements,dof,free_dof,nnz_l,setup_s,solve_ms,step_ms,iterations_per_step,step_over_solve`.
 
 use flexbody::model::body_file::MeshSpec;
-use flexbody::model::{BodyFile, VariableType};
+use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
 use std::fmt::Write as _;
@@ -21,12 +21,6 @@ use std::time::Instant;
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
     v[v.len() / 2]
-}
-
-fn set(s: &mut Slave, name: &str, value: f64) {
-    let v = s.variables().by_name(name).unwrap().clone();
-    assert_eq!(v.ty, VariableType::Real);
-    s.set_real(v.value_reference, value).unwrap();
 }
 
 fn main() {
@@ -65,8 +59,8 @@ fn main() {
         let mut s = Slave::from_body(body_file).unwrap();
         s.setup_experiment(0.0, None, None).unwrap();
         s.enter_initialization_mode().unwrap();
-        set(&mut s, "solver.stepSize", h);
-        set(&mut s, "tip.force[2]", -10.0);
+        s.set_by_name("solver.stepSize", h).unwrap();
+        s.set_by_name("tip.force[2]", -10.0).unwrap();
         s.exit_initialization_mode().unwrap();
         let mut t = 0.0;
         s.do_step(t, h).unwrap(); // the first step at a step size factorises

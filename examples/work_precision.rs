@@ -22,9 +22,8 @@
 //! tables; with `--csv FILE` also writes one row per run:
 //! `problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error` (model quoted).
 
-use flexbody::model::{BodyFile, VariableType};
+use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use nalgebra::{Rotation3, Vector3};
 use std::fmt::Write as _;
 use std::time::Instant;
 #[path = "../tests/common/b3.rs"]
@@ -50,16 +49,9 @@ fn slave(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Slave {
     let mut s = Slave::from_body(body.clone()).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();
     s.enter_initialization_mode().unwrap();
-    s.set_real(vr(&s, "solver.stepSize"), h).unwrap();
+    s.set_by_name("solver.stepSize", h).unwrap();
     for (name, value) in settings {
-        let v = s.variables().by_name(name).unwrap().clone();
-        match v.ty {
-            VariableType::Integer => s.set_integer(v.value_reference, *value),
-            VariableType::Boolean => s.set_boolean(v.value_reference, *value != 0),
-            VariableType::Real => s.set_real(v.value_reference, *value as f64),
-            VariableType::String => panic!("{name} is a String"),
-        }
-        .unwrap();
+        s.set_by_name(name, f64::from(*value)).unwrap();
     }
     s
 }
@@ -92,31 +84,18 @@ fn b3(
 ) -> Result<(Vec<f64>, f64), String> {
     let mut s = slave(body, h, settings);
     s.exit_initialization_mode().map_err(|e| e.message)?;
-    let rotation: Vec<u32> = (1..=9)
-        .map(|k| vr(&s, &format!("hub.rotation[{k}]")))
-        .collect();
-    let rate = vr(&s, "hub.angularVelocity[3]");
-    let tip: Vec<u32> = (1..=3)
-        .map(|k| vr(&s, &format!("tip.position[{k}]")))
-        .collect();
+    let drive = b3::HubDrive::new(&s);
     let steps = (end / h).round() as usize;
     let every = (2e-2 / h).round() as usize;
     let mut y = vec![0.0];
     let started = Instant::now();
     for k in 0..steps {
         let t = k as f64 * h;
-        let (theta, omega) = b3::hub(t);
-        let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
-        for (c, &r) in rotation.iter().enumerate() {
-            s.set_real(r, q.matrix()[(c / 3, c % 3)]).unwrap();
-        }
-        s.set_real(rate, omega).unwrap();
-        s.do_step(t, h)
+        let yk = drive
+            .step(&mut s, t, h)
             .map_err(|e| format!("t = {t}: {}", e.message))?;
         if (k + 1) % every == 0 {
-            let p = Vector3::from_fn(|c, _| s.get_real(tip[c]).unwrap());
-            let back = Rotation3::from_axis_angle(&Vector3::z_axis(), b3::hub(t + h).0).inverse();
-            y.push((back * p).y);
+            y.push(yk);
         }
     }
     Ok((y, started.elapsed().as_secs_f64()))

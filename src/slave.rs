@@ -451,6 +451,38 @@ impl Slave {
         &self.variables
     }
 
+    /// Sets a Real, Integer or Boolean variable by name (for scripts and measurements: an
+    /// Integer takes `value` when it is integral, a Boolean `value != 0`); the same checks as
+    /// the typed setters.
+    pub fn set_by_name(&mut self, name: &str, value: f64) -> Result<()> {
+        let v = self
+            .variables
+            .by_name(name)
+            .ok_or_else(|| Error::new(format!("no variable is named {name}")))?;
+        let (vr, ty) = (v.value_reference, v.ty);
+        match ty {
+            VariableType::Real => self.set_real(vr, value),
+            VariableType::Integer if value.fract() == 0.0 && value.abs() <= i32::MAX as f64 => {
+                self.set_integer(vr, value as i32)
+            }
+            VariableType::Integer => Err(Error::invalid_value(name, value, "not an integer")),
+            VariableType::Boolean => self.set_boolean(vr, value != 0.0),
+            VariableType::String => Err(Error::new(format!(
+                "{name} is a String variable: use set_string"
+            ))),
+        }
+    }
+
+    /// A Real variable by name.
+    pub fn get_by_name(&mut self, name: &str) -> Result<f64> {
+        let vr = self
+            .variables
+            .by_name(name)
+            .ok_or_else(|| Error::new(format!("no variable is named {name}")))?
+            .value_reference;
+        self.get_real(vr)
+    }
+
     /// The current parameter values.
     pub fn parameters(&self) -> &Parameters {
         &self.parameters

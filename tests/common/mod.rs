@@ -3,7 +3,7 @@
 
 pub mod b3;
 
-use flexbody::model::{BodyFile, VariableType};
+use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 
 /// Timoshenko tip deflection of B1 under 10 N (BENCHMARKS.md), m.
@@ -20,18 +20,13 @@ pub fn vr(slave: &Slave, name: &str) -> u32 {
 }
 
 pub fn set(slave: &mut Slave, name: &str, value: f64) {
-    let v = slave.variables().by_name(name).unwrap().clone();
-    match v.ty {
-        VariableType::Real => slave.set_real(v.value_reference, value).unwrap(),
-        VariableType::Integer => slave.set_integer(v.value_reference, value as i32).unwrap(),
-        VariableType::Boolean => slave.set_boolean(v.value_reference, value != 0.0).unwrap(),
-        VariableType::String => panic!("{name} is a String: use Slave::set_string"),
-    }
+    slave
+        .set_by_name(name, value)
+        .unwrap_or_else(|e| panic!("{}", e.message));
 }
 
 pub fn get(slave: &mut Slave, name: &str) -> f64 {
-    let r = vr(slave, name);
-    slave.get_real(r).unwrap()
+    slave.get_by_name(name).unwrap()
 }
 
 /// The body file `examples/<name>.json`.
@@ -57,24 +52,9 @@ pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     initialized(BodyFile::default_body(), settings)
 }
 
-/// One B3 step: the hub's rotation and rate of the schedule at `t` as inputs of the motion
-/// interface `hub`, a step of `h`, and the tip deflection in the hub frame at `t + h` (m).
+/// One B3 step (see [`b3::HubDrive`]): the tip deflection in the hub frame at `t + h` (m).
 pub fn b3_step(slave: &mut Slave, t: f64, h: f64) -> f64 {
-    use nalgebra::{Rotation3, Vector3};
-    let (theta, rate) = b3::hub(t);
-    let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), theta).matrix();
-    for c in 0..9 {
-        set(
-            slave,
-            &format!("hub.rotation[{}]", c + 1),
-            q[(c / 3, c % 3)],
-        );
-    }
-    set(slave, "hub.angularVelocity[3]", rate);
-    slave.do_step(t, h).unwrap();
-    let q1 = Rotation3::from_axis_angle(&Vector3::z_axis(), b3::hub(t + h).0);
-    let tip = Vector3::from_fn(|c, _| get(slave, &format!("tip.position[{}]", c + 1)));
-    (q1.inverse() * tip).y
+    b3::HubDrive::new(slave).step(slave, t, h).unwrap()
 }
 
 /// The body file at `path`.
