@@ -9,13 +9,9 @@
 
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
-use std::time::Instant;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    v[v.len() / 2]
-}
+#[path = "support/mod.rs"]
+mod support;
 
 fn bodies(paths: &[String]) -> Vec<BodyFile> {
     if !paths.is_empty() {
@@ -55,44 +51,21 @@ fn main() {
             }
             s.exit_initialization_mode().unwrap();
 
-            // The floor: one forward + backward solve with a factor of the same matrix.
-            let body = s.body().unwrap();
-            let free = s.free_nodes().unwrap();
-            let scheme = GeneralizedAlpha::new(s.parameters().rho_inf);
-            let matrix = IterationMatrix::new(body, free, &scheme, h, 0.0, 0.0).unwrap();
-            let mut ws = matrix.factor.solve_scratch();
-            let mut rhs = vec![1.0; free.dof_count()];
-            let mut solve = Vec::new();
-            for _ in 0..200 {
-                rhs.iter_mut().for_each(|v| *v = 1.0);
-                let t = Instant::now();
-                matrix.factor.solve_in_place(&mut rhs, &mut ws);
-                solve.push(t.elapsed().as_secs_f64());
-            }
-            let solve = median(solve);
+            s.do_step(0.0, h).unwrap(); // the first step at a step size factorises
+                                        // The floor: one forward + backward solve with the slave's own factor.
+            let solve = support::solve_time(&s, h, 200);
+            let (body, free) = (s.body().unwrap(), s.free_nodes().unwrap());
             let (dof, free_dof) = (body.reference.len(), free.dof_count());
-            let (nnz_k, nnz_l) = (body.stiffness_matrix.nnz(), matrix.factor.factor_nnz());
-
-            let mut times = Vec::with_capacity(steps);
-            let mut t = 0.0;
-            s.do_step(t, h).unwrap(); // the first step at a step size may factorise
-            t += h;
-            let (steps0, iterations0) = s.solver_statistics();
-            for _ in 0..steps {
-                let t1 = Instant::now();
-                s.do_step(t, h).unwrap();
-                times.push(t1.elapsed().as_secs_f64());
-                t += h;
-            }
-            let (steps1, iterations1) = s.solver_statistics();
-            let step = median(times);
+            let nnz_k = body.stiffness_matrix.nnz();
+            let nnz_l = s.iteration_matrix(h).unwrap().factor.factor_nnz();
+            let (step, iterations, _) = support::step_time(&mut s, h, h, steps);
             println!(
                 "| {} | {h:e} | {dof} ({free_dof}) | {nnz_k} | {nnz_l} | {:.3} | {:.3} | {:.0} | {:.2} | {:.2} |",
                 body_file.name,
                 1e3 * solve,
                 1e3 * step,
                 1.0 / step,
-                (iterations1 - iterations0) as f64 / (steps1 - steps0) as f64,
+                iterations,
                 step / solve
             );
         }

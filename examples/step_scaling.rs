@@ -14,22 +14,17 @@
 use flexbody::model::body_file::MeshSpec;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
 use std::fmt::Write as _;
 use std::time::Instant;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    v[v.len() / 2]
-}
+#[path = "support/mod.rs"]
+mod support;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let quick = args.iter().any(|a| a == "--quick");
-    let csv_path = args
-        .iter()
-        .position(|a| a == "--csv")
-        .map(|k| std::path::PathBuf::from(&args[k + 1]));
+    let support::BenchArgs {
+        quick,
+        csv: csv_path,
+    } = support::BenchArgs::parse();
     let sizes: &[[usize; 3]] = if quick {
         &[[10, 1, 1], [20, 2, 2]]
     } else {
@@ -67,37 +62,16 @@ fn main() {
         t += h;
         let setup = started.elapsed().as_secs_f64();
 
-        let body = s.body().unwrap();
-        let free = s.free_nodes().unwrap();
-        let scheme = GeneralizedAlpha::new(s.parameters().rho_inf);
-        let matrix = IterationMatrix::new(body, free, &scheme, h, 0.0, 0.0).unwrap();
-        let mut ws = matrix.factor.solve_scratch();
-        let n_free = free.dof_count();
-        let mut rhs = vec![1.0; n_free];
+        // The floor: one forward + backward solve with the slave's own factor.
+        let nnz_l = s.iteration_matrix(h).unwrap().factor.factor_nnz();
         // Enough repetitions for a median, few enough for ~1-3 s per size.
-        let repeats = (2e7 / matrix.factor.factor_nnz() as f64).clamp(10.0, 200.0) as usize;
-        let mut solve = Vec::new();
-        for _ in 0..repeats {
-            rhs.iter_mut().for_each(|v| *v = 1.0);
-            let t1 = Instant::now();
-            matrix.factor.solve_in_place(&mut rhs, &mut ws);
-            solve.push(t1.elapsed().as_secs_f64());
-        }
-        let solve = median(solve);
-        let (dof, nnz_l) = (body.reference.len(), matrix.factor.factor_nnz());
-        drop(matrix);
-
-        let (steps0, iterations0) = s.solver_statistics();
-        let mut times = Vec::new();
-        for _ in 0..repeats {
-            let t1 = Instant::now();
-            s.do_step(t, h).unwrap();
-            times.push(t1.elapsed().as_secs_f64());
-            t += h;
-        }
-        let (steps1, iterations1) = s.solver_statistics();
-        let step = median(times);
-        let iterations = (iterations1 - iterations0) as f64 / (steps1 - steps0) as f64;
+        let repeats = (2e7 / nnz_l as f64).clamp(10.0, 200.0) as usize;
+        let solve = support::solve_time(&s, h, repeats);
+        let (dof, n_free) = (
+            s.body().unwrap().reference.len(),
+            s.free_nodes().unwrap().dof_count(),
+        );
+        let (step, iterations, _) = support::step_time(&mut s, t, h, repeats);
         let elements = divisions.iter().product::<usize>();
         println!(
             "| {}×{}×{} | {dof} ({n_free}) | {nnz_l} | {setup:.2} | {:.3} | {:.3} | {:.0} | {iterations:.2} | {:.2} |",

@@ -109,18 +109,15 @@ fn max_error(y: &[f64], reference: &[f64]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    v[v.len() / 2]
-}
+#[path = "support/mod.rs"]
+mod support;
+use support::median;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let quick = args.iter().any(|a| a == "--quick");
-    let csv_path = args
-        .iter()
-        .position(|a| a == "--csv")
-        .map(|k| std::path::PathBuf::from(&args[k + 1]));
+    let support::BenchArgs {
+        quick,
+        csv: csv_path,
+    } = support::BenchArgs::parse();
     let mut csv =
         String::from("problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error\n");
     let repeats = if quick { 1 } else { 3 };

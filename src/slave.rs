@@ -639,6 +639,16 @@ impl Slave {
         self.model.as_ref().map(|m| &m.free)
     }
 
+    /// The cached factorization of the iteration matrix for internal step `h`, if a step of that
+    /// size has been taken (for measurements: the floor of a step is one solve with it).
+    pub fn iteration_matrix(&self, h: f64) -> Option<&IterationMatrix> {
+        self.model
+            .as_ref()?
+            .matrices
+            .iter()
+            .find(|m| (m.step_size - h).abs() <= 1e-9 * h)
+    }
+
     /// The assembled body once initialized.
     pub fn body(&self) -> Option<&Body> {
         self.model.as_ref().map(|m| &m.body)
