@@ -26,9 +26,10 @@ fn run(settings: &[(&str, f64)]) -> (Vec<f64>, f64) {
     };
     divisions[0] = 20;
     let mut s = initialized(body, settings);
+    let drive = common::b3::HubDrive::new(&s);
     let mut history = Vec::new();
     for k in 0..(END / H).round() as usize {
-        history.push(b3_step(&mut s, k as f64 * H, H));
+        history.push(drive.step(&mut s, k as f64 * H, H).unwrap());
     }
     let (steps, iterations) = s.solver_statistics();
     (history, iterations as f64 / steps as f64)

@@ -88,10 +88,11 @@ fn a_fast_spin_keeps_momentum() {
 /// B3's tip deflection in the hub frame at every 0.5 s up to 4 s.
 fn b3_spin_up(body: flexbody::model::BodyFile) -> Vec<f64> {
     let mut s = initialized(body, &[]);
+    let drive = common::b3::HubDrive::new(&s);
     let h = 1e-2;
     let mut y = Vec::new();
     for k in 0..400 {
-        let yk = b3_step(&mut s, k as f64 * h, h);
+        let yk = drive.step(&mut s, k as f64 * h, h).unwrap();
         if (k + 1) % 50 == 0 {
             y.push(yk);
         }

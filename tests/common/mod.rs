@@ -52,11 +52,6 @@ pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     initialized(BodyFile::default_body(), settings)
 }
 
-/// One B3 step (see [`b3::HubDrive`]): the tip deflection in the hub frame at `t + h` (m).
-pub fn b3_step(slave: &mut Slave, t: f64, h: f64) -> f64 {
-    b3::HubDrive::new(slave).step(slave, t, h).unwrap()
-}
-
 /// The body file at `path`.
 pub fn example_body_at(path: &std::path::Path) -> BodyFile {
     BodyFile::from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
