@@ -1462,11 +1462,13 @@ impl Slave {
         let p = &self.parameters;
         p.material.validate()?;
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
+        // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
+        let lumped = fem::lumped_masses(&self.mesh, p.material.density);
         let body = Body::new(
             reference,
             fem::scalar_mass_matrix(&self.mesh, p.material.density),
             fem::stiffness_matrix(&self.mesh, &p.material),
-            fem::lumped_masses(&self.mesh, p.material.density),
+            lumped.clone(),
             BodyOptions {
                 nonlinear_forces: p.nonlinear_forces,
                 damping_alpha: p.damping_alpha,
@@ -1476,7 +1478,6 @@ impl Slave {
         let body = if p.formulation == FORMULATION_FULL {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
         } else if p.frames > 1 {
-            let lumped = fem::lumped_masses(&self.mesh, p.material.density);
             body.with_patches(Patches::along_principal_axis(
                 &self.mesh,
                 &p.material,
@@ -1529,7 +1530,6 @@ impl Slave {
             ),
         });
         let explicit = if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
-            let lumped = fem::lumped_masses(&self.mesh, p.material.density);
             let scheme = CentralDifference::new(&body, &lumped, &free)?;
             self.events.push(LogEvent {
                 category: "logEvents",
