@@ -2,11 +2,11 @@
 //! save and restore. Knows nothing of C pointers: the FMI glue in `fmi2` calls it after checking
 //! arguments and the calling sequence.
 
-use crate::body::frame::{nearest_rotation, node, set_node};
+use crate::body::frame::{nearest_rotation, node};
 use crate::body::interface::{DrivingFrame, InterfaceMotion};
 use crate::body::stiffening::Stiffening;
 use crate::body::strain_monitor::{StrainMonitor, DEFAULT_THRESHOLD};
-use crate::body::{Body, BodyOptions, NodeSet, Patches};
+use crate::body::{Body, BodyOptions, NodeSet, Patches, Reduction};
 use crate::error::{Error, ErrorKind, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
@@ -42,6 +42,7 @@ type InputDerivatives = [Inputs; 2];
 /// `model.formulation` item of the full nonlinear reference.
 const FORMULATION_FULL: i32 = 2;
 /// `model.stiffening` items.
+const STIFFENING_NONE: i32 = 1;
 const STIFFENING_INERTIAL: i32 = 2;
 const STIFFENING_STRESS: i32 = 3;
 /// `solver.integrator` items.
@@ -96,6 +97,8 @@ pub struct Parameters {
     pub stiffening: i32,
     /// `model.frames`: co-moving frames of the reduced-strain body (≥ 1).
     pub frames: i32,
+    /// `model.modes`: 0 the full mesh, `n > 0` the reduced body with `n` fixed-interface modes.
+    pub modes: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
     /// `solver.integrator`: 1 generalized-α, 2 central difference.
@@ -129,6 +132,7 @@ impl Parameters {
             formulation: 1,
             stiffening: 1,
             frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
+            modes: b.model.modes.min(i32::MAX as u32) as i32,
             anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
             integrator: match b.solver.integrator {
                 Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
@@ -141,7 +145,7 @@ impl Parameters {
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
     /// placement, the step size and the iteration settings).
-    fn model_key(&self) -> (IsotropicMaterial, [u64; 3], bool, [i32; 4]) {
+    fn model_key(&self) -> ModelKey {
         (
             self.material,
             [
@@ -155,6 +159,7 @@ impl Parameters {
                 self.frames,
                 self.anderson_depth,
                 self.integrator,
+                self.modes,
             ],
         )
     }
@@ -200,8 +205,11 @@ struct Interface {
 }
 
 /// The assembled model for one set of parameters.
+/// What the assembled model depends on (see [`Parameters::model_key`]).
+type ModelKey = (IsotropicMaterial, [u64; 3], bool, [i32; 5]);
+
 struct Model {
-    key: (IsotropicMaterial, [u64; 3], bool, [i32; 4]),
+    key: ModelKey,
     body: Body,
     free: FreeNodes,
     scheme: GeneralizedAlpha,
@@ -720,8 +728,16 @@ impl Slave {
         self.start_time = state.start_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];
-        if state.dynamics.is_some() {
+        if let Some(d) = &state.dynamics {
             self.ensure_model()?;
+            let expected = 3 * self.model.as_ref().unwrap().body.node_count();
+            if d.state.position.len() != expected {
+                return Err(Error::new(format!(
+                    "the FMU state has {} coordinates, this body (model.modes = {}) has {expected}: it belongs to another body",
+                    d.state.position.len(),
+                    self.parameters.modes
+                )));
+            }
         }
         match (&mut self.dynamics, &state.dynamics) {
             (Some(d), Some(s)) if d.state.position.len() == s.state.position.len() => {
@@ -945,6 +961,20 @@ impl Slave {
                     ));
                 }
                 self.parameters.frames = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Modes,
+                ..
+            } => {
+                if value < 0 {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        "must not be negative (0: the full mesh)",
+                    ));
+                }
+                self.parameters.modes = value;
                 Ok(())
             }
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
@@ -1464,16 +1494,87 @@ impl Slave {
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
         // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
         let lumped = fem::lumped_masses(&self.mesh, p.material.density);
+        let options = BodyOptions {
+            nonlinear_forces: p.nonlinear_forces,
+            damping_alpha: p.damping_alpha,
+            damping_beta: p.damping_beta,
+        };
+        let mass_matrix = fem::scalar_mass_matrix(&self.mesh, p.material.density);
+        let stiffness_matrix = fem::stiffness_matrix(&self.mesh, &p.material);
+        if p.modes > 0 {
+            self.check_reducible()?;
+            let p = &self.parameters;
+            let started = std::time::Instant::now();
+            let (boundary, loaded): (Vec<&NodeSet>, Vec<&NodeSet>) = {
+                let sets = |kinds: &[InterfaceKind]| {
+                    self.interfaces
+                        .iter()
+                        .filter(|i| kinds.contains(&i.kind))
+                        .map(|i| &i.set)
+                        .collect::<Vec<_>>()
+                };
+                (
+                    sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
+                    sets(&[InterfaceKind::Force]),
+                )
+            };
+            let reduction = Reduction::new(
+                &reference,
+                &mass_matrix,
+                &stiffness_matrix,
+                &lumped,
+                &boundary,
+                &loaded,
+                p.modes as usize,
+            )?;
+            let frequencies: Vec<String> = reduction
+                .mode_eigenvalues
+                .iter()
+                .map(|l| format!("{:.4}", l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)))
+                .collect();
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "reduced the body (model.modes = {}): {} nodes → {} fields ({} coordinates); fixed-interface mode frequencies [{}] Hz ({:.3} s)",
+                    p.modes,
+                    reduction.node_count,
+                    reduction.field_count,
+                    3 * reduction.field_count,
+                    frequencies.join(", "),
+                    started.elapsed().as_secs_f64()
+                ),
+            });
+            let mut held = reduction.held.iter();
+            for interface in &mut self.interfaces {
+                let holds = matches!(interface.kind, InterfaceKind::Fixed | InterfaceKind::Motion);
+                let coordinates = if holds {
+                    held.next().cloned().unwrap_or_default()
+                } else {
+                    Vec::new()
+                };
+                interface.set.set_reduction(Some((&reduction, coordinates)));
+            }
+            let mut clamped = vec![false; reduction.field_count];
+            for interface in &self.interfaces {
+                if matches!(interface.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
+                    for k in interface.set.held_indices() {
+                        clamped[k] = true;
+                    }
+                }
+            }
+            let body = Body::reduced(reduction, options);
+            return self.finish_model(key, body, clamped, &lumped);
+        }
+        for interface in &mut self.interfaces {
+            interface.set.set_reduction(None);
+        }
+        let p = &self.parameters;
         let body = Body::new(
             reference,
-            fem::scalar_mass_matrix(&self.mesh, p.material.density),
-            fem::stiffness_matrix(&self.mesh, &p.material),
+            mass_matrix,
+            stiffness_matrix,
             lumped.clone(),
-            BodyOptions {
-                nonlinear_forces: p.nonlinear_forces,
-                damping_alpha: p.damping_alpha,
-                damping_beta: p.damping_beta,
-            },
+            options,
         );
         let body = if p.formulation == FORMULATION_FULL {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
@@ -1487,8 +1588,68 @@ impl Slave {
         } else {
             body
         };
+        let clamped = self.clamped.clone();
+        self.finish_model(key, body, clamped, &lumped)
+    }
+
+    /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
+    /// stiffening, pins or hinges; anything else is an error naming the parameter.
+    fn check_reducible(&self) -> Result<()> {
+        let p = &self.parameters;
+        let reason = if p.formulation == FORMULATION_FULL {
+            Some(
+                "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
+            )
+        } else if p.frames > 1 {
+            Some(format!(
+                "model.frames = {}: a reduced body has one co-moving frame",
+                p.frames
+            ))
+        } else if p.stiffening != STIFFENING_NONE {
+            Some(format!(
+                "model.stiffening = {}: geometric stiffening is not projected on the modes",
+                if p.stiffening == STIFFENING_INERTIAL {
+                    "inertial"
+                } else {
+                    "stress"
+                }
+            ))
+        } else if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
+            Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
+        } else {
+            self.interfaces
+                .iter()
+                .zip(&self.body_file.interfaces)
+                .find(|(i, _)| matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge))
+                .map(|(i, spec)| {
+                    format!(
+                        "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
+                        spec.name, i.kind
+                    )
+                })
+        };
+        match reason {
+            Some(r) => Err(Error::invalid_value(
+                "model.modes",
+                self.parameters.modes,
+                &r,
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// The solver's side of a model build: free nodes, constraints, stiffening, the explicit
+    /// scheme, the logs.
+    fn finish_model(
+        &mut self,
+        key: ModelKey,
+        body: Body,
+        clamped: Vec<bool>,
+        lumped: &[f64],
+    ) -> Result<()> {
+        let p = &self.parameters;
         let started = std::time::Instant::now();
-        let mut free = FreeNodes::new(&body, &self.clamped);
+        let mut free = FreeNodes::new(&body, &clamped);
         for (k, interface) in self.interfaces.iter_mut().enumerate() {
             interface.first_constraint = free.constraints.len();
             for (nodes, weights) in &interface.point_constraints {
@@ -1519,8 +1680,9 @@ impl Slave {
         self.events.push(LogEvent {
             category: "logEvents",
             message: format!(
-                "assembled the body: {} nodes, {} elements, {} DOF ({} free), nnz(K) = {}, mass {:.6e} kg ({:.3} s)",
+                "assembled the body: {} {}, {} elements, {} DOF ({} free), nnz(K) = {}, mass {:.6e} kg ({:.3} s)",
                 body.node_count(),
+                if body.reduction.is_some() { "fields" } else { "nodes" },
                 self.mesh.element_count(),
                 body.reference.len(),
                 free.dof_count(),
@@ -1530,7 +1692,7 @@ impl Slave {
             ),
         });
         let explicit = if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
-            let scheme = CentralDifference::new(&body, &lumped, &free)?;
+            let scheme = CentralDifference::new(&body, lumped, &free)?;
             self.events.push(LogEvent {
                 category: "logEvents",
                 message: format!(
@@ -1552,6 +1714,8 @@ impl Slave {
         } else {
             None
         };
+        let monitored =
+            p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {
             key,
             body,
@@ -1559,13 +1723,15 @@ impl Slave {
             matrices: Vec::new(),
             mass: ConsistentAcceleration::new(&free)?,
             explicit,
-            strain_monitor: (p.formulation != FORMULATION_FULL && p.frames == 1)
-                .then(|| (StrainMonitor::new(&self.mesh), false)),
+            strain_monitor: monitored.then(|| (StrainMonitor::new(&self.mesh), false)),
             free,
             workspace,
             stiffening,
         });
         self.dynamics = None;
+        // The backups have the old model's size (a changed model.modes changes it).
+        self.backup = None;
+        self.retry_backup = None;
         Ok(())
     }
 
@@ -1680,11 +1846,15 @@ impl Slave {
             pseudo_acceleration: vec![0.0; 3 * n],
             multipliers: vec![0.0; model.free.multiplier_count()],
         };
-        for i in 0..n {
-            let r = q * (node(&body.reference, i) - anchor);
-            set_node(&mut state.position, i, &(origin + r));
-            set_node(&mut state.velocity, i, &(v0 + w0.cross(&r)));
-        }
+        body.place_rigidly(
+            &origin,
+            &q,
+            &anchor,
+            &v0,
+            &w0,
+            &mut state.position,
+            &mut state.velocity,
+        );
         // Every other motion interface must hold in this rigid placement.
         let tolerance = 1e-6 * self.size;
         for (k, interface) in self.interfaces.iter().enumerate() {
@@ -1715,7 +1885,7 @@ impl Slave {
         }
         for interface in &self.interfaces {
             if interface.kind == InterfaceKind::Fixed {
-                for &i in &interface.set.frame_weights.nodes {
+                for i in interface.set.held_indices() {
                     state.velocity[3 * i..3 * i + 3].fill(0.0);
                 }
             }
@@ -1808,7 +1978,7 @@ impl Slave {
             for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
                 mv += ms.values[k] * node(&state.velocity, ms.col_idx[k]);
             }
-            angular += (node(&state.position, i) - com).cross(&mv);
+            angular += (node(&state.position, i) - body.unit(i) * com).cross(&mv);
             kinetic += 0.5 * node(&state.velocity, i).dot(&mv);
         }
         let r = kin.frame.rotation;
@@ -2162,6 +2332,7 @@ fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
         FixedKey::Formulation => Some(p.formulation),
         FixedKey::Stiffening => Some(p.stiffening),
         FixedKey::Frames => Some(p.frames),
+        FixedKey::Modes => Some(p.modes),
         FixedKey::AndersonDepth => Some(p.anderson_depth),
         FixedKey::Integrator => Some(p.integrator),
         _ => None,

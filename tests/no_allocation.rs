@@ -17,6 +17,7 @@ fn do_step_does_not_allocate_after_the_first_step() {
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0)]);
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.frames", 5.0)]);
     steps_do_not_allocate(&[("solver.andersonDepth", 0.0)]);
+    steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.modes", 4.0)]);
 }
 
 /// Steps of the default body with damping, gravity, a tip load and `settings`.

@@ -44,6 +44,13 @@ pub fn nearest_rotation(a: &Matrix3<f64>) -> Matrix3<f64> {
 /// Weights and reference geometry of a best-fit frame over a set of nodes: positive weights
 /// `w_i` (kg, HRZ-lumped masses for the body frame), the weighted reference centroid `X_c` and
 /// the reference offsets `X̄_i = X_i − X_c`.
+///
+/// The same frame serves a reduced body ([`super::reduction`]), whose coordinates `q_k` are the
+/// coefficients of scalar fields `S_k` (`x_i = Σ_k S_ik q_k`): there the "weights" are
+/// `Σ_i w_i S_ik` (any sign), the arms `a_k = Σ_i w_i S_ik X̄_i`, and `e_k` (the coefficients of
+/// the constant field, `Σ_k S_ik e_k = 1`) replaces the 1 of every node in `x_i − c`. With
+/// `a_i = w_i X̄_i` and `e_i = 1` the formulas below are the nodal ones, so one code serves both
+/// and gives the reduced body exactly the frame of its expanded nodes.
 #[derive(Debug, Clone)]
 pub struct FrameWeights {
     pub nodes: Vec<usize>,
@@ -51,6 +58,10 @@ pub struct FrameWeights {
     pub total_weight: f64,
     pub reference_centroid: Vector3<f64>,
     pub reference_offsets: Vec<Vector3<f64>>,
+    /// `a_k = w_k X̄_k` (nodes) or `Σ_i w_i S_ik X̄_i` (reduced body) (kg·m).
+    pub arms: Vec<Vector3<f64>>,
+    /// `e_k`, the coefficients of the constant field; `None`: 1 for every node.
+    pub unit: Option<Vec<f64>>,
 }
 
 /// A frame: origin `c` (m) and rotation `R` (columns: frame axes in global coordinates).
@@ -74,9 +85,14 @@ impl FrameWeights {
             centroid += w * node(reference, n);
         }
         centroid /= total_weight;
-        let reference_offsets = nodes
+        let reference_offsets: Vec<Vector3<f64>> = nodes
             .iter()
             .map(|&n| node(reference, n) - centroid)
+            .collect();
+        let arms = weights
+            .iter()
+            .zip(&reference_offsets)
+            .map(|(&w, xbar)| w * xbar)
             .collect();
         FrameWeights {
             nodes,
@@ -84,7 +100,37 @@ impl FrameWeights {
             total_weight,
             reference_centroid: centroid,
             reference_offsets,
+            arms,
+            unit: None,
         }
+    }
+
+    /// The frame of a reduced body with coordinates `q_k` (see the type's documentation):
+    /// `weights_k = Σ_i w_i S_ik`, `total_weight = Σ_i w_i`, `X_c`, the reference offsets
+    /// `X̄_k = q_ref,k − X_c e_k`, the arms `a_k` and `e_k`.
+    pub fn reduced(
+        weights: Vec<f64>,
+        total_weight: f64,
+        reference_centroid: Vector3<f64>,
+        reference_offsets: Vec<Vector3<f64>>,
+        arms: Vec<Vector3<f64>>,
+        unit: Vec<f64>,
+    ) -> FrameWeights {
+        FrameWeights {
+            nodes: (0..weights.len()).collect(),
+            weights,
+            total_weight,
+            reference_centroid,
+            reference_offsets,
+            arms,
+            unit: Some(unit),
+        }
+    }
+
+    /// `e_k` of coordinate `k` (1 for a node).
+    #[inline]
+    pub fn unit(&self, k: usize) -> f64 {
+        self.unit.as_ref().map_or(1.0, |u| u[k])
     }
 
     /// Weighted centroid `c = Σ w_i x_i / Σ w_i` of a flat `3N` vector `x` (positions,
@@ -97,17 +143,13 @@ impl FrameWeights {
         c / self.total_weight
     }
 
-    /// The best-fit frame of positions `x`: `c` and `R = polar(Σ w_i (x_i − c) X̄_iᵀ)`.
+    /// The best-fit frame of positions `x`: `c` and `R = polar(Σ w_i (x_i − c) X̄_iᵀ)`
+    /// (`= polar(Σ_k (q_k − c e_k) a_kᵀ)`).
     pub fn best_fit(&self, x: &[f64]) -> Frame {
         let origin = self.centroid(x);
         let mut a = Matrix3::zeros();
-        for ((&n, &w), xbar) in self
-            .nodes
-            .iter()
-            .zip(&self.weights)
-            .zip(&self.reference_offsets)
-        {
-            a += w * (node(x, n) - origin) * xbar.transpose();
+        for (k, (&n, arm)) in self.nodes.iter().zip(&self.arms).enumerate() {
+            a += (node(x, n) - self.unit(k) * origin) * arm.transpose();
         }
         Frame {
             origin,
@@ -120,14 +162,10 @@ impl FrameWeights {
     /// `H δθ = −Σ w_i X̄_i × Rᵀ δx_i` (body-frame `δθ`).
     pub fn rotation_sensitivity(&self, frame: &Frame, x: &[f64]) -> Matrix3<f64> {
         let mut h = Matrix3::zeros();
-        for ((&n, &w), xbar) in self
-            .nodes
-            .iter()
-            .zip(&self.weights)
-            .zip(&self.reference_offsets)
-        {
-            let y = frame.rotation.transpose() * (node(x, n) - frame.origin); // X̄_i + ū_i
-            h += w * skew(xbar) * skew(&y);
+        for (k, (&n, arm)) in self.nodes.iter().zip(&self.arms).enumerate() {
+            // X̄_i + ū_i
+            let y = frame.rotation.transpose() * (node(x, n) - self.unit(k) * frame.origin);
+            h += skew(arm) * skew(&y);
         }
         h
     }
@@ -137,13 +175,8 @@ impl FrameWeights {
     pub fn angular_velocity(&self, frame: &Frame, h_inv: &Matrix3<f64>, v: &[f64]) -> Vector3<f64> {
         let mut b = Vector3::zeros();
         let rt = frame.rotation.transpose();
-        for ((&n, &w), xbar) in self
-            .nodes
-            .iter()
-            .zip(&self.weights)
-            .zip(&self.reference_offsets)
-        {
-            b += w * xbar.cross(&(rt * node(v, n)));
+        for (&n, arm) in self.nodes.iter().zip(&self.arms) {
+            b += arm.cross(&(rt * node(v, n)));
         }
         -(h_inv * b)
     }

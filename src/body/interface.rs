@@ -3,8 +3,10 @@
 //! power-conjugate to it, and the resultant of nodal loads about the reference point.
 
 use super::frame::{add_node, node, set_node, Frame, FrameWeights};
+use super::reduction::{HeldCoordinate, Reduction};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
+use std::cell::RefCell;
 
 /// A node set with positive weights `w_i` and a reference point.
 ///
@@ -20,6 +22,29 @@ pub struct NodeSet {
     pub frame_weights: FrameWeights,
     /// Reference point in reference coordinates (m).
     pub reference_point: Vector3<f64>,
+    /// On a reduced body ([`Reduction`]): how the set's nodes follow the body's coordinates.
+    /// The vectors the methods take are then the reduced body's (flat `3s`).
+    pub expansion: Option<Box<SetExpansion>>,
+}
+
+/// A node set of a reduced body: its nodes' rows of the basis `S`, so that
+/// `x_i = Σ_k S_ik q_k` on the set and a nodal load `f_i` is the generalized load
+/// `Σ_i S_ik f_i` (the virtual work of the load is the same in both: the coupling stays
+/// power-neutral).
+#[derive(Debug, Clone)]
+pub struct SetExpansion {
+    /// Rows `S_i·` of the set's nodes in set order (row-major `n_set × s`).
+    rows: Vec<f64>,
+    fields: usize,
+    /// The set with its nodes numbered `0..n_set` in set order.
+    local: NodeSet,
+    /// The coordinates the set holds (fixed support, motion interface); empty otherwise.
+    pub held: Vec<HeldCoordinate>,
+    /// `Σ_i (w_i / W) S_ik`: the generalized load of a force alone when the reference point is
+    /// the centroid (then `f_i = w_i F / W` does not depend on the positions).
+    force_weights: Option<Vec<f64>>,
+    /// Expanded positions, velocities, accelerations and loads of the set (4 × `3 n_set`).
+    scratch: RefCell<Vec<f64>>,
 }
 
 /// Rigid motion of a node set at its reference point (global frame, SI units).
@@ -61,7 +86,61 @@ impl NodeSet {
         Ok(NodeSet {
             frame_weights,
             reference_point,
+            expansion: None,
         })
+    }
+
+    /// Puts the set on the reduced body `reduction`, holding `held` (empty for a loaded set);
+    /// `None` puts it back on the mesh nodes.
+    pub fn set_reduction(&mut self, reduction: Option<(&Reduction, Vec<HeldCoordinate>)>) {
+        let Some((reduction, held)) = reduction else {
+            self.expansion = None;
+            return;
+        };
+        let fw = &self.frame_weights;
+        let s = reduction.field_count;
+        let n_set = fw.nodes.len();
+        let mut rows = Vec::with_capacity(n_set * s);
+        let mut local_reference = Vec::with_capacity(3 * n_set);
+        for &i in &fw.nodes {
+            rows.extend_from_slice(reduction.row(i));
+            local_reference.extend_from_slice(&reduction.mesh_reference[3 * i..3 * i + 3]);
+        }
+        let local = NodeSet {
+            frame_weights: FrameWeights::new(
+                (0..n_set).collect(),
+                fw.weights.clone(),
+                &local_reference,
+            ),
+            reference_point: self.reference_point,
+            expansion: None,
+        };
+        let force_weights = (self.reference_point == fw.reference_centroid).then(|| {
+            let mut w = vec![0.0; s];
+            for (j, &wj) in fw.weights.iter().enumerate() {
+                for k in 0..s {
+                    w[k] += wj / fw.total_weight * rows[j * s + k];
+                }
+            }
+            w
+        });
+        self.expansion = Some(Box::new(SetExpansion {
+            rows,
+            fields: s,
+            local,
+            held,
+            force_weights,
+            scratch: RefCell::new(vec![0.0; 12 * n_set]),
+        }));
+    }
+
+    /// The nodes (or, on a reduced body, the coordinates) the set holds when it is a fixed
+    /// support or a motion interface.
+    pub fn held_indices(&self) -> Vec<usize> {
+        match &self.expansion {
+            Some(e) => e.held.iter().map(|h| h.index).collect(),
+            None => self.frame_weights.nodes.clone(),
+        }
     }
 
     /// Current position of the reference point: `c + R (p_ref − X_c)` with the best-fit frame.
@@ -79,6 +158,9 @@ impl NodeSet {
         torque: &Vector3<f64>,
         f: &mut [f64],
     ) {
+        if let Some(e) = &self.expansion {
+            return e.distribute(x, force, torque, f);
+        }
         let fw = &self.frame_weights;
         let frame = fw.best_fit(x);
         let p = self.reference_point_at(&frame);
@@ -95,6 +177,9 @@ impl NodeSet {
     /// Resultant force and torque about the current reference point of the nodal loads `f`
     /// restricted to the set.
     pub fn resultant(&self, x: &[f64], f: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+        if let Some(e) = &self.expansion {
+            return e.resultant(x, f);
+        }
         let fw = &self.frame_weights;
         let frame = fw.best_fit(x);
         let p = self.reference_point_at(&frame);
@@ -112,6 +197,9 @@ impl NodeSet {
     /// accelerations `a`; the angular acceleration is that of the least-squares rigid acceleration
     /// field `a_i ≈ a_c + α × r_i + ω × (ω × r_i)`.
     pub fn motion(&self, x: &[f64], v: &[f64], a: &[f64]) -> InterfaceMotion {
+        if let Some(e) = &self.expansion {
+            return e.motion(x, v, a);
+        }
         let fw = &self.frame_weights;
         let frame = fw.best_fit(x);
         let p = self.reference_point_at(&frame);
@@ -191,12 +279,102 @@ impl NodeSet {
     ) {
         let (p, q) = frame.at(tau);
         let w = frame.angular_velocity;
+        if let Some(e) = &self.expansion {
+            // q_k = p + Q d (a point) or Q d (a direction), see `HeldCoordinate`.
+            for h in &e.held {
+                let r = q * h.offset;
+                let (x0, v0) = if h.point {
+                    (p, frame.velocity)
+                } else {
+                    (Vector3::zeros(), Vector3::zeros())
+                };
+                set_node(x, h.index, &(x0 + r));
+                set_node(v, h.index, &(v0 + w.cross(&r)));
+                set_node(a, h.index, &w.cross(&w.cross(&r)));
+            }
+            return;
+        }
         for &n in &self.frame_weights.nodes {
             let r = q * (node(reference, n) - self.reference_point);
             set_node(x, n, &(p + r));
             set_node(v, n, &(frame.velocity + w.cross(&r)));
             set_node(a, n, &w.cross(&w.cross(&r)));
         }
+    }
+}
+
+impl SetExpansion {
+    /// `x_j = Σ_k S_jk q_k` for the set's nodes `j` (flat `3 n_set`).
+    fn expand(&self, q: &[f64], out: &mut [f64]) {
+        let s = self.fields;
+        for (j, row) in self.rows.chunks_exact(s).enumerate() {
+            let mut xj = Vector3::zeros();
+            for (k, &sk) in row.iter().enumerate() {
+                xj += sk * node(q, k);
+            }
+            set_node(out, j, &xj);
+        }
+    }
+
+    fn distribute(&self, q: &[f64], force: &Vector3<f64>, torque: &Vector3<f64>, f: &mut [f64]) {
+        if let (Some(w), true) = (&self.force_weights, torque.norm_squared() == 0.0) {
+            for (k, &wk) in w.iter().enumerate() {
+                add_node(f, k, &(wk * force));
+            }
+            return;
+        }
+        let n3 = self.local.frame_weights.nodes.len() * 3;
+        let mut scratch = self.scratch.borrow_mut();
+        let (xs, rest) = scratch.split_at_mut(n3);
+        let fs = &mut rest[..n3];
+        self.expand(q, xs);
+        fs.fill(0.0);
+        self.local.distribute(xs, force, torque, fs);
+        // Σ_j S_jk f_j
+        let s = self.fields;
+        for (j, row) in self.rows.chunks_exact(s).enumerate() {
+            let fj = node(fs, j);
+            for (k, &sk) in row.iter().enumerate() {
+                add_node(f, k, &(sk * fj));
+            }
+        }
+    }
+
+    fn motion(&self, q: &[f64], v: &[f64], a: &[f64]) -> InterfaceMotion {
+        let n3 = self.local.frame_weights.nodes.len() * 3;
+        let mut scratch = self.scratch.borrow_mut();
+        let (xs, rest) = scratch.split_at_mut(n3);
+        let (vs, rest) = rest.split_at_mut(n3);
+        let avs = &mut rest[..n3];
+        self.expand(q, xs);
+        self.expand(v, vs);
+        self.expand(a, avs);
+        self.local.motion(xs, vs, avs)
+    }
+
+    /// Force and torque about the current reference point `p` of the generalized loads `f` on
+    /// the held coordinates: with `x_i = q_0 + Σ_a φ_a(X_i) q_a` on the set,
+    /// `Σ f_i = r_0` and `Σ (x_i − p) × f_i = (q_0 − p) × r_0 + Σ_a q_a × r_a`.
+    fn resultant(&self, q: &[f64], f: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
+        let n3 = self.local.frame_weights.nodes.len() * 3;
+        let p = {
+            let mut scratch = self.scratch.borrow_mut();
+            let xs = &mut scratch[..n3];
+            self.expand(q, xs);
+            let frame = self.local.frame_weights.best_fit(xs);
+            self.local.reference_point_at(&frame)
+        };
+        let (mut force, mut torque) = (Vector3::zeros(), Vector3::zeros());
+        for h in &self.held {
+            let (qk, rk) = (node(q, h.index), node(f, h.index));
+            if h.point {
+                force += rk;
+                torque += (qk - p).cross(&rk);
+            } else {
+                torque += qk.cross(&rk);
+            }
+        }
+        (force, torque)
     }
 }
 

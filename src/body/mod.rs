@@ -5,12 +5,14 @@
 pub mod frame;
 pub mod interface;
 pub mod patches;
+pub mod reduction;
 pub mod stiffening;
 pub mod strain_monitor;
 
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
 pub use patches::Patches;
+pub use reduction::Reduction;
 
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::sparse::BlockCsr3;
@@ -67,6 +69,10 @@ pub struct Body {
     /// force is `Σ_p R_p K_p ū_p` (+ each patch's `f_nl`) instead of the body frame's `R K ū`;
     /// damping and stiffening stay in the body frame.
     pub patches: Option<Patches>,
+    /// The reduced body (`model.modes`, [`reduction`]): when present the "nodes" are the
+    /// coordinates `q_k` of the basis fields, the matrices are the projected ones and this holds
+    /// the basis to expand `q` to the mesh nodes.
+    pub reduction: Option<Box<Reduction>>,
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -139,6 +145,59 @@ impl Body {
             options,
             full: None,
             patches: None,
+            reduction: None,
+        }
+    }
+
+    /// The reduced body of `reduction` ([`reduction`]): coordinates `q_k`, mass `Sᵀ Ms S`,
+    /// stiffness `K_r`, the frame of the expanded nodes; `M (e ⊗ a)` for uniform loads.
+    pub fn reduced(reduction: Reduction, options: BodyOptions) -> Body {
+        let s = reduction.field_count;
+        let mut mass_row_sums = vec![0.0; s];
+        reduction
+            .mass_matrix
+            .mul_vec(&reduction.unit, &mut mass_row_sums);
+        let total_mass = dot(&mass_row_sums, &reduction.unit);
+        Body {
+            reference: reduction.reference.clone(),
+            mass_matrix: reduction.mass_matrix.clone(),
+            stiffness_blocks: BlockCsr3::from_csr(&reduction.stiffness_matrix),
+            stiffness_matrix: reduction.stiffness_matrix.clone(),
+            mass_row_sums,
+            total_mass,
+            frame_weights: reduction.frame_weights.clone(),
+            options,
+            full: None,
+            patches: None,
+            reduction: Some(Box::new(reduction)),
+        }
+    }
+
+    /// `e_i`: 1 for a node, the constant field's coefficient for a reduced coordinate.
+    #[inline]
+    pub fn unit(&self, i: usize) -> f64 {
+        self.frame_weights.unit(i)
+    }
+
+    /// The rigid placement `x_i = p + Q (X_i − a)`, `ẋ_i = v + ω × Q (X_i − a)` (origin `p`,
+    /// rotation `Q`, anchor `a` in reference coordinates, velocity `v`, angular velocity `ω`)
+    /// written to `x` and `v` (flat `3N`; for a reduced body its coordinates).
+    #[allow(clippy::too_many_arguments)] // a rigid motion is these five quantities
+    pub fn place_rigidly(
+        &self,
+        origin: &Vector3<f64>,
+        rotation: &Matrix3<f64>,
+        anchor: &Vector3<f64>,
+        velocity: &Vector3<f64>,
+        angular_velocity: &Vector3<f64>,
+        x: &mut [f64],
+        v: &mut [f64],
+    ) {
+        for i in 0..self.node_count() {
+            let e = self.unit(i);
+            let r = rotation * (node(&self.reference, i) - e * anchor);
+            set_node(x, i, &(e * origin + r));
+            set_node(v, i, &(e * velocity + angular_velocity.cross(&r)));
         }
     }
 
@@ -225,7 +284,7 @@ impl Body {
         let n = self.node_count();
         let ubar = &mut scratch.local_deformation;
         for i in 0..n {
-            let u = rt * (node(x, i) - frame.origin) - fw.reference_offsets[i];
+            let u = rt * (node(x, i) - fw.unit(i) * frame.origin) - fw.reference_offsets[i];
             set_node(ubar, i, &u);
         }
         let g = &mut scratch.elastic_force;
@@ -255,7 +314,7 @@ impl Body {
             let rate = &mut scratch.deformation_rate;
             for i in 0..n {
                 let y = fw.reference_offsets[i] + node(ubar, i);
-                let d = rt * (node(v, i) - cdot) - angular_velocity_body.cross(&y);
+                let d = rt * (node(v, i) - fw.unit(i) * cdot) - angular_velocity_body.cross(&y);
                 set_node(rate, i, &d);
             }
             let (alpha, beta) = (self.options.damping_alpha, self.options.damping_beta);
@@ -275,7 +334,8 @@ impl Body {
                 let (centre, velocity, omega) = self.rigid_velocity(x, v, &mut scratch.mass_times);
                 let relative = &mut scratch.deformation_rate;
                 for i in 0..n {
-                    let vr = velocity + omega.cross(&(node(x, i) - centre));
+                    let e = fw.unit(i);
+                    let vr = e * velocity + omega.cross(&(node(x, i) - e * centre));
                     set_node(relative, i, &(node(v, i) - vr));
                 }
                 let mt = &mut scratch.mass_times;
@@ -314,7 +374,7 @@ impl Body {
                 fi += node(&scratch.stiffening_force, i);
             }
             if self.options.nonlinear_forces && single {
-                fi -= fw.weights[i] * fw.reference_offsets[i].cross(&z);
+                fi -= fw.arms[i].cross(&z);
             }
             let mut global = r * fi;
             if !single {
@@ -359,10 +419,11 @@ impl Body {
         let ms = &self.mass_matrix;
         let (mut momentum, mut inertia) = (Vector3::zeros(), Matrix3::zeros());
         for i in 0..ms.n {
-            let ri = node(x, i) - centre;
+            let ri = node(x, i) - self.unit(i) * centre;
             momentum += ri.cross(&node(mv, i));
             for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
-                let rj = node(x, ms.col_idx[k]) - centre;
+                let j = ms.col_idx[k];
+                let rj = node(x, j) - self.unit(j) * centre;
                 inertia += ms.values[k] * (Matrix3::identity() * ri.dot(&rj) - ri * rj.transpose());
             }
         }

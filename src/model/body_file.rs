@@ -213,6 +213,11 @@ pub struct ModelSpec {
     /// the whole body.
     #[serde(default = "ModelSpec::default_frames")]
     pub frames: u32,
+    /// Reduced body (`model.modes`, see `body::reduction`): 0 (the default) moves every mesh
+    /// node; `n > 0` restricts the deformation to `n` fixed-interface modes plus the interfaces'
+    /// constraint and attachment modes (component mode synthesis in absolute coordinates).
+    #[serde(default)]
+    pub modes: u32,
 }
 
 impl Default for ModelSpec {
@@ -220,6 +225,7 @@ impl Default for ModelSpec {
         ModelSpec {
             nonlinear_forces: false,
             frames: ModelSpec::default_frames(),
+            modes: 0,
         }
     }
 }

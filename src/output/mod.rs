@@ -95,16 +95,25 @@ impl ResultWriter {
             }
         }
         let n = mesh.node_count();
-        let displacement: Vec<f64> = x.iter().zip(&body.reference).map(|(a, b)| a - b).collect();
+        // The frame of the body's coordinates; a reduced body's nodes are `x_i = Σ_k S_ik q_k`.
         let frame = body.frame_weights.best_fit(x);
         let centroid = body.frame_weights.reference_centroid;
+        let (expanded, reference) = match &body.reduction {
+            Some(r) => ((r.expand(x), r.expand(v)), &r.mesh_reference),
+            None => ((Vec::new(), Vec::new()), &body.reference),
+        };
+        let (x, v) = match &body.reduction {
+            Some(_) => (&expanded.0[..], &expanded.1[..]),
+            None => (x, v),
+        };
+        let displacement: Vec<f64> = x.iter().zip(reference).map(|(a, b)| a - b).collect();
         let mut deformation = vec![0.0; 3 * n];
         for i in 0..n {
             let xi = nalgebra::Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
             let reference = nalgebra::Vector3::new(
-                body.reference[3 * i],
-                body.reference[3 * i + 1],
-                body.reference[3 * i + 2],
+                reference[3 * i],
+                reference[3 * i + 1],
+                reference[3 * i + 2],
             );
             let u = frame.rotation.transpose() * (xi - frame.origin) - (reference - centroid);
             deformation[3 * i..3 * i + 3].copy_from_slice(u.as_slice());

@@ -7,7 +7,7 @@
 //! | --- | --- |
 //! | payload format | u32 = [`PAYLOAD_FORMAT`] |
 //! | interfaces `n` | u32 |
-//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator: i32; nonlinear forces: u8 |
+//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces: u8 |
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | start time | f64 |
@@ -26,7 +26,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::generalized_alpha::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 1;
+pub const PAYLOAD_FORMAT: u32 = 2;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -137,6 +137,7 @@ impl SlaveState {
         w.i32(p.frames);
         w.i32(p.anderson_depth);
         w.i32(p.integrator);
+        w.i32(p.modes);
         w.u8(u8::from(p.nonlinear_forces));
         self.inputs.iter().for_each(|i| w.f64s(i));
         for d in &self.input_derivatives {
@@ -207,6 +208,7 @@ impl Slave {
         p.frames = r.i32("model.frames")?;
         p.anderson_depth = r.i32("solver.andersonDepth")?;
         p.integrator = r.i32("solver.integrator")?;
+        p.modes = r.i32("model.modes")?;
         p.nonlinear_forces = match r.u8("model.nonlinearForces")? {
             0 => false,
             1 => true,
@@ -236,8 +238,22 @@ impl Slave {
             0 => None,
             1 => {
                 let time = r.f64("the time")?;
-                let n3 = 3 * self.mesh.node_count();
-                r.count(n3, "position coordinates")?;
+                let n3 = if p.modes == 0 {
+                    let n3 = 3 * self.mesh.node_count();
+                    r.count(n3, "position coordinates")?;
+                    n3
+                } else {
+                    // A reduced body: 3 per field, at most 3 per mesh node; `set_state` checks
+                    // the count against the reduction it builds.
+                    let n3 = r.u64("position coordinates")?;
+                    if n3 % 3 != 0 || n3 > 3 * self.mesh.node_count() as u64 {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state has {n3} position coordinates: not a reduced body of this mesh ({} nodes)",
+                            self.mesh.node_count()
+                        )));
+                    }
+                    n3 as usize
+                };
                 let mut vectors = [vec![0.0; n3], vec![0.0; n3], vec![0.0; n3], vec![0.0; n3]];
                 for (v, what) in vectors.iter_mut().zip([
                     "positions",
@@ -345,6 +361,9 @@ fn check_parameters(p: &Parameters) -> Result<()> {
     }
     if p.frames < 1 {
         return bad("model.frames", p.frames, "must be at least 1");
+    }
+    if p.modes < 0 {
+        return bad("model.modes", p.modes, "must not be negative");
     }
     if !(0..=crate::solver::anderson::MAX_DEPTH as i32).contains(&p.anderson_depth) {
         return bad("solver.andersonDepth", p.anderson_depth, "not in [0, 8]");

@@ -60,7 +60,7 @@ impl NonlinearForceCorrection {
             let column = &mut y[j * n..(j + 1) * n];
             let e = Vector3::ith(j, 1.0);
             for (k, &i) in free.nodes.iter().enumerate() {
-                let b = -fw.weights[i] * fw.reference_offsets[i].cross(&e);
+                let b = -fw.arms[i].cross(&e);
                 column[3 * k..3 * k + 3].copy_from_slice(b.as_slice());
             }
             factor.solve_in_place(column, workspace);

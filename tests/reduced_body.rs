@@ -1,0 +1,461 @@
+//! The reduced body (`model.modes`, `body::reduction`) against the full mesh: B1's static
+//! deflection and bending frequencies (library level), the step response through the slave, a
+//! rotating motion interface, a free tumbling body, the FMU state and the parameter checks.
+
+mod common;
+use common::*;
+use flexbody::body::{NodeSet, Reduction};
+use flexbody::fem::modal::lowest_eigenpairs;
+use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::mesh::{Mesh, NodeSelector};
+use flexbody::model::BodyFile;
+use flexbody::slave::Slave;
+use flexbody::solver::SparseCholesky;
+use nalgebra::{DMatrix, DVector, Matrix3, Rotation3, Vector3};
+
+fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
+    NodeSelector::Plane {
+        point: [x, 0.0, 0.0],
+        normal: [1.0, 0.0, 0.0],
+        tolerance: None,
+    }
+    .select(mesh)
+    .unwrap()
+}
+
+/// B1 on the default mesh (hex20 20×2×2), root face clamped, 10 N in −y on the tip face.
+struct B1 {
+    mesh: Mesh,
+    reference: Vec<f64>,
+    lumped: Vec<f64>,
+    root: NodeSet,
+    tip: NodeSet,
+}
+
+impl B1 {
+    fn new() -> B1 {
+        let body = BodyFile::default_body();
+        let mesh = body.mesh.build(None).unwrap();
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let lumped = lumped_masses(&mesh, IsotropicMaterial::STEEL.density);
+        let set = |name: &str, x: f64, point: Option<Vector3<f64>>| {
+            let nodes = face(&mesh, x);
+            let weights = nodes.iter().map(|&i| lumped[i]).collect();
+            NodeSet::new(name, nodes, weights, &reference, point).unwrap()
+        };
+        let root = set("root", 0.0, None);
+        let tip = set("tip", 1.0, Some(Vector3::new(1.0, 0.0, 0.0)));
+        B1 {
+            mesh,
+            reference,
+            lumped,
+            root,
+            tip,
+        }
+    }
+
+    /// Mean y-displacement of the tip face (HRZ weights) of the nodal displacement `u`.
+    fn tip_deflection(&self, u: &[f64]) -> f64 {
+        let fw = &self.tip.frame_weights;
+        fw.nodes
+            .iter()
+            .zip(&fw.weights)
+            .map(|(&i, &w)| w * u[3 * i + 1])
+            .sum::<f64>()
+            / fw.total_weight
+    }
+
+    /// DOFs not on the root face.
+    fn free_dofs(&self) -> Vec<usize> {
+        let root = &self.root.frame_weights.nodes;
+        (0..self.mesh.node_count())
+            .filter(|i| !root.contains(i))
+            .flat_map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect()
+    }
+}
+
+/// The generalized eigenvalues `K v = λ M v` of dense symmetric `K`, `M` (M positive definite),
+/// ascending.
+fn generalized_eigenvalues(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Vec<f64> {
+    let l = m.clone().cholesky().unwrap().unpack();
+    let li = l.clone().try_inverse().unwrap();
+    let a = &li * k * li.transpose();
+    let a = 0.5 * (&a + a.transpose());
+    let mut values: Vec<f64> = a.symmetric_eigen().eigenvalues.iter().copied().collect();
+    values.sort_by(f64::total_cmp);
+    values
+}
+
+fn hz(lambda: f64) -> f64 {
+    lambda.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)
+}
+
+/// B1's static deflection and its lowest bending frequencies, reduced (`modes = 4`) against the
+/// full mesh. Both are exact in theory, so the tolerances are round-off-level, far inside the
+/// issue's 0.5 %:
+/// * the static response to the tip load is the tip set's attachment mode, which is in the
+///   basis; the only loss is the Gram–Schmidt cutoff (`DEPENDENCE_CUTOFF` = 1e-6 of a field), so
+///   1e-5 relative;
+/// * with the whole boundary clamped, the fixed-interface modes are B1's modes, so the 4 kept
+///   are exact to the subspace iteration's 1e-9 (the Ritz value error is quadratic in the shape
+///   error): 1e-7 relative. The next two (f5, f6, torsion/axial or the third bending pair) are
+///   Rayleigh–Ritz upper bounds of the full mesh's.
+#[test]
+fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
+    let mut b1 = B1::new();
+    let material = IsotropicMaterial::STEEL;
+    let k = stiffness_matrix(&b1.mesh, &material);
+    let ms = scalar_mass_matrix(&b1.mesh, material.density);
+    let reduction = Reduction::new(
+        &b1.reference,
+        &ms,
+        &k,
+        &b1.lumped,
+        &[&b1.root],
+        &[&b1.tip],
+        4,
+    )
+    .unwrap();
+
+    // Full mesh.
+    let free = b1.free_dofs();
+    let mut load = vec![0.0; b1.reference.len()];
+    b1.tip.distribute(
+        &b1.reference,
+        &Vector3::new(0.0, -10.0, 0.0),
+        &Vector3::zeros(),
+        &mut load,
+    );
+    let mut u_free: Vec<f64> = free.iter().map(|&d| load[d]).collect();
+    let factor = SparseCholesky::new(&k.submatrix(&free)).unwrap();
+    factor.solve_in_place(&mut u_free, &mut factor.solve_scratch());
+    let mut u = vec![0.0; b1.reference.len()];
+    for (&d, &v) in free.iter().zip(&u_free) {
+        u[d] = v;
+    }
+    let full_deflection = b1.tip_deflection(&u);
+    let full_modes = lowest_eigenpairs(
+        &k.submatrix(&free),
+        &ms.kron_i3().submatrix(&free),
+        6,
+        1e-12,
+        500,
+    )
+    .unwrap();
+
+    // Reduced body: the root's held coordinates are clamped, the rest is free.
+    let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
+    let coordinates: Vec<usize> = (0..reduction.field_count)
+        .filter(|k| !held.contains(k))
+        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+        .collect();
+    let n = coordinates.len();
+    let k_r = reduction.stiffness_matrix.to_dense();
+    let m_r = reduction.mass_matrix.kron_i3().to_dense();
+    let k_ff = DMatrix::from_fn(n, n, |a, b| k_r[(coordinates[a], coordinates[b])]);
+    let m_ff = DMatrix::from_fn(n, n, |a, b| m_r[(coordinates[a], coordinates[b])]);
+    b1.tip.set_reduction(Some((&reduction, Vec::new())));
+    let mut f = vec![0.0; 3 * reduction.field_count];
+    b1.tip.distribute(
+        &reduction.reference,
+        &Vector3::new(0.0, -10.0, 0.0),
+        &Vector3::zeros(),
+        &mut f,
+    );
+    let f_free = DVector::from_fn(n, |a, _| f[coordinates[a]]);
+    let q_free = k_ff.clone().cholesky().unwrap().solve(&f_free);
+    let mut q = vec![0.0; 3 * reduction.field_count];
+    for (a, &c) in coordinates.iter().enumerate() {
+        q[c] = q_free[a];
+    }
+    let reduced_deflection = b1.tip_deflection(&reduction.expand(&q));
+    let reduced_eigenvalues = generalized_eigenvalues(&k_ff, &m_ff);
+
+    let static_error = (reduced_deflection / full_deflection - 1.0).abs();
+    println!(
+        "static tip deflection: full {full_deflection:.9e} m, reduced ({} fields, {n} free coordinates) {reduced_deflection:.9e} m, relative difference {static_error:.2e}",
+        reduction.field_count
+    );
+    assert!(static_error < 1e-5, "{static_error:e}");
+    for (j, (&full, &reduced)) in full_modes
+        .eigenvalues
+        .iter()
+        .zip(&reduced_eigenvalues)
+        .enumerate()
+    {
+        let error = reduced / full - 1.0;
+        println!(
+            "f{}: full {:.6} Hz, reduced {:.6} Hz ({:+.2e})",
+            j + 1,
+            hz(full),
+            hz(reduced),
+            error
+        );
+        if j < 4 {
+            assert!(error.abs() < 1e-7, "f{}: {error:e}", j + 1);
+        } else {
+            assert!(error > -1e-9, "f{} below the full mesh's: {error:e}", j + 1);
+        }
+    }
+}
+
+/// Tip deflection history (relative to the start) of the step response of B1 (10 N at t = 0,
+/// undamped, ρ∞ = 1, h = 1e-4 s) over 30 ms (half a period of f1), and the wall time.
+fn step_response(modes: f64) -> (Vec<f64>, f64) {
+    let h = 1e-4;
+    let mut s = initialized_default(&[
+        ("model.modes", modes),
+        ("tip.force[2]", -10.0),
+        ("solver.stepSize", h),
+        ("solver.rhoInf", 1.0),
+    ]);
+    let y0 = get(&mut s, "tip.position[2]");
+    let started = std::time::Instant::now();
+    let history = (0..300)
+        .map(|k| {
+            s.do_step(k as f64 * h, h).unwrap();
+            get(&mut s, "tip.position[2]") - y0
+        })
+        .collect();
+    (history, started.elapsed().as_secs_f64())
+}
+
+/// The step response through the whole slave converges to the full mesh's as modes are added:
+/// the truncated modes (above f_{n+1}) keep their static part through the attachment modes and
+/// lose only their dynamic part, which shrinks with f_{n+1}. With 8 modes (f9 ≈ 900 Hz) the
+/// largest deviation over the first half period is within the 0.5 % of the peak
+/// deflection, and below a tenth of the deviation with 2 modes.
+#[test]
+fn step_response_converges_to_the_full_mesh_with_the_number_of_modes() {
+    let (full, full_time) = step_response(0.0);
+    let peak = full.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
+    let deviation = |modes: f64| {
+        let (reduced, time) = step_response(modes);
+        let worst = reduced
+            .iter()
+            .zip(&full)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()))
+            / peak;
+        println!(
+            "modes {modes}: largest deviation {:.3e} of the peak {peak:.4e} m; {:.3} s against the full mesh's {full_time:.3} s",
+            worst, time
+        );
+        worst
+    };
+    let coarse = deviation(2.0);
+    let fine = deviation(8.0);
+    assert!(fine < 5e-3, "{fine:e}");
+    assert!(fine < 0.1 * coarse, "{fine:e} vs {coarse:e}");
+}
+
+fn vector(s: &mut Slave, name: &str) -> Vector3<f64> {
+    Vector3::from_fn(|k, _| get(s, &format!("{name}[{}]", k + 1)))
+}
+
+fn set_rotation(s: &mut Slave, name: &str, q: &Matrix3<f64>) {
+    for r in 0..3 {
+        for c in 0..3 {
+            set(s, &format!("{name}[{}]", 3 * r + c + 1), q[(r, c)]);
+        }
+    }
+}
+
+/// B4 on the reduced body: the root is a motion interface turning about z at π rad/s for three
+/// turns, the tip load turning with it; the tip deflection in the root frame stays at the
+/// full mesh's clamped static value within 0.5 % (as `tests/motion_interface.rs` asks of the
+/// full mesh). A motion interface holds its set's affine coordinates, so the driven reduced body
+/// sees the same clamp as a fixed support.
+#[test]
+fn b4_reduced_body_driven_by_a_rotating_motion_interface() {
+    let omega = std::f64::consts::PI;
+    let h = 1e-3;
+    let body = example_body("driven_cantilever");
+    let mut s = initialized(
+        body,
+        &[
+            ("model.modes", 6.0),
+            ("damping.beta", 2e-3),
+            ("tip.force[2]", -10.0),
+            ("root.angularVelocity[3]", omega),
+        ],
+    );
+    let mut fixed = initialized_default(&[("damping.beta", 2e-2), ("tip.force[2]", -10.0)]);
+    let y0 = get(&mut fixed, "tip.position[2]");
+    for k in 0..600 {
+        fixed.do_step(k as f64 * h, h).unwrap();
+    }
+    let static_deflection = get(&mut fixed, "tip.position[2]") - y0;
+    let mut worst: f64 = 0.0;
+    for k in 0..(6.0 / h).round() as usize {
+        let t = k as f64 * h;
+        let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), omega * t).matrix();
+        set_rotation(&mut s, "root.rotation", &q);
+        let load = q * Vector3::new(0.0, -10.0, 0.0);
+        for c in 0..3 {
+            set(&mut s, &format!("tip.force[{}]", c + 1), load[c]);
+        }
+        s.do_step(t, h).unwrap();
+        if t + h >= 4.0 {
+            let q_end = *Rotation3::from_axis_angle(&Vector3::z_axis(), omega * (t + h)).matrix();
+            let local = q_end.transpose()
+                * (vector(&mut s, "tip.position") - vector(&mut s, "root.position"));
+            worst = worst.max((local.y - static_deflection).abs() / static_deflection.abs());
+        }
+    }
+    println!(
+        "largest deviation from the static deflection: {:.3e}",
+        worst
+    );
+    assert!(worst < 5e-3, "{:.3} %", 100.0 * worst);
+    // Steady turning: the driving frame's load and the tip load give the centre of mass its
+    // centripetal acceleration, F_root + F_tip = m (−ω² r) with r the centre of mass from the
+    // axis (the start-up transient has decayed by e^{-60}; the scheme's error in ω² r is
+    // O((ωh)²) = 1e-5): 1e-4 of the ~18 N.
+    // The tip load is held over each step: the last one was set at t = 6 s − h.
+    let q_last = *Rotation3::from_axis_angle(&Vector3::z_axis(), omega * (6.0 - h)).matrix();
+    let tip_load = q_last * Vector3::new(0.0, -10.0, 0.0);
+    let r = vector(&mut s, "body.position") - vector(&mut s, "root.position");
+    let mass = 7850.0 * 0.02 * 0.02 * 1.0;
+    let expected = -mass * omega * omega * Vector3::new(r.x, r.y, 0.0) - tip_load;
+    let f = vector(&mut s, "root.force");
+    println!("root.force {f:?}, expected {expected:?}");
+    assert!(
+        (f - expected).norm() < 1e-4 * expected.norm(),
+        "root.force {f:?}, expected {expected:?}"
+    );
+}
+
+/// Largest relative change of the angular momentum over 0.5 s of B2's tumbling beam (softened
+/// to E = 2.1e8 Pa, ω = (0.5, 3, 7) rad/s about the centre of mass, f_nl on) reduced to 8
+/// free-free modes, and the largest linear momentum relative to m |ω| L/2.
+fn tumbling_drift(h: f64) -> (f64, f64) {
+    let w = Vector3::new(0.5, 3.0, 7.0);
+    let v = -w.cross(&Vector3::new(0.5, 0.0, 0.0));
+    let mut s = initialized(
+        example_body("tumbling"),
+        &[
+            ("model.modes", 8.0),
+            ("initial.angularVelocity[1]", w.x),
+            ("initial.angularVelocity[2]", w.y),
+            ("initial.angularVelocity[3]", w.z),
+            ("initial.velocity[1]", v.x),
+            ("initial.velocity[2]", v.y),
+            ("initial.velocity[3]", v.z),
+            ("solver.stepSize", h),
+            ("material.youngsModulus", 2.1e8),
+        ],
+    );
+    let l0 = vector(&mut s, "body.angularMomentum");
+    let (mut worst_l, mut worst_p) = (0.0_f64, 0.0_f64);
+    for k in 0..(0.5 / h).round() as usize {
+        s.do_step(k as f64 * h, h).unwrap();
+        let l = vector(&mut s, "body.angularMomentum");
+        let p = vector(&mut s, "body.linearMomentum");
+        worst_l = worst_l.max((l - l0).norm() / l0.norm());
+        worst_p = worst_p.max(p.norm() / (7850.0 * 0.02 * 0.02 * 7.6 * 0.5));
+    }
+    (worst_l, worst_p)
+}
+
+/// A free reduced body keeps the full mesh's conservation properties (B2, as
+/// `tests/free_body.rs` shows them for the mesh): the affine fields hold every rigid motion
+/// exactly and the projected f_nl is still the gradient of the projected energy, so the linear
+/// momentum is conserved to round-off and the angular momentum to the trapezoidal rule's own
+/// truncation error, which falls as h² (ratio 4 per halving, ±10 %).
+#[test]
+fn free_reduced_body_conserves_momentum() {
+    let (coarse, p_coarse) = tumbling_drift(1e-3);
+    let (fine, p_fine) = tumbling_drift(5e-4);
+    println!("angular momentum drift {coarse:e} (h = 1e-3), {fine:e} (h = 5e-4); linear {p_coarse:e} {p_fine:e}");
+    assert!(
+        p_coarse < 1e-12 && p_fine < 1e-12,
+        "linear momentum {p_coarse:e} {p_fine:e}"
+    );
+    let ratio = coarse / fine;
+    assert!((3.6..4.4).contains(&ratio), "ratio {ratio}");
+}
+
+/// `fmi2GetFMUstate`/`fmi2SetFMUstate` and the byte form carry the reduced body's coordinates:
+/// restoring the state reproduces the later steps bit for bit. The parameters are part of the
+/// state, so a full-mesh state restored into an instance running reduced switches it back to the
+/// full mesh (interfaces included) and reproduces the full mesh's steps, and back again.
+#[test]
+fn fmu_state_of_a_reduced_body_round_trips() {
+    fn bytes(s: &Slave) -> Vec<u8> {
+        let mut out = Vec::new();
+        s.get_state().write_bytes(&mut out);
+        out
+    }
+    fn restore(s: &mut Slave, bytes: &[u8]) {
+        let state = s.state_from_bytes(bytes).unwrap();
+        s.set_state(&state).unwrap();
+    }
+    fn run(s: &mut Slave) -> Vec<f64> {
+        (5..10)
+            .map(|k| {
+                s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+                get(s, "tip.position[2]")
+            })
+            .collect()
+    }
+    let mut full = initialized_default(&[("tip.force[2]", -10.0)]);
+    let mut s = initialized_default(&[("model.modes", 4.0), ("tip.force[2]", -10.0)]);
+    for k in 0..5 {
+        s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+        full.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+    }
+    let reduced_state = bytes(&s);
+    let full_state = bytes(&full);
+    let reduced_run = run(&mut s);
+    let full_run = run(&mut full);
+    assert_ne!(reduced_run, full_run);
+    restore(&mut s, &reduced_state);
+    assert_eq!(run(&mut s), reduced_run);
+    restore(&mut s, &full_state);
+    assert_eq!(run(&mut s), full_run);
+    restore(&mut s, &reduced_state);
+    assert_eq!(run(&mut s), reduced_run);
+}
+
+/// Combinations the reduced body does not support are errors that name `model.modes` and say
+/// why, at initialization.
+#[test]
+fn unsupported_combinations_are_errors_naming_the_parameter() {
+    for (setting, value, reason) in [
+        ("model.formulation", 2.0, "full"),
+        ("model.frames", 3.0, "frames"),
+        ("model.stiffening", 2.0, "stiffening"),
+        ("solver.integrator", 2.0, "centralDifference"),
+    ] {
+        let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+        s.setup_experiment(0.0, None, None).unwrap();
+        s.enter_initialization_mode().unwrap();
+        set(&mut s, "model.modes", 4.0);
+        set(&mut s, setting, value);
+        let e = s.exit_initialization_mode().unwrap_err();
+        assert!(
+            e.message.contains("model.modes") && e.message.contains(reason),
+            "{setting}: {e}"
+        );
+    }
+    let mut body = BodyFile::default_body();
+    body.interfaces[0].kind = flexbody::model::InterfaceKind::Pin;
+    let mut s = Slave::from_body(body).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.modes", 4.0);
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(
+        e.message.contains("'root'") && e.message.contains("Pin"),
+        "{e}"
+    );
+    // Too many modes for the mesh.
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.modes", 1e6);
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(e.message.contains("model.modes"), "{e}");
+    assert!(s.set_by_name("model.modes", -1.0).is_err());
+}
