@@ -1,0 +1,459 @@
+//! The implicit Runge–Kutta scheme of the seed paper: Radau IIA with 3 stages (order 5, stage
+//! order 3, L-stable; Hairer & Wanner, *Solving ODEs II*, section IV.8), in constant-matrix form
+//! (`solver.integrator = radauIIA`).
+//!
+//! The equations of motion `M ẍ + f(x, ẋ) = f_ext(t, x)` on the free DOFs, written for the stage
+//! position increments `Z_i = X_i − x_n` (`i = 1..3`, stage times `t_n + c_i h`): the collocation
+//! polynomial gives the stage velocities and accelerations
+//!
+//! ```text
+//! V = h⁻¹ (A⁻¹ ⊗ I) Z,        Ẍ = h⁻² (A⁻² ⊗ I) Z − h⁻¹ (A⁻¹𝟙 ⊗ ẋ_n)        (A the Radau matrix)
+//! r_i(Z) = M Ẍ_i + f(X_i, V_i) − f_ext(t_n + c_i h, X_i) = 0                    (stage equations)
+//! ```
+//!
+//! and, since `c_3 = 1` (stiffly accurate), `x_{n+1} = X_3`, `ẋ_{n+1} = V_3`, `ẍ_{n+1} = Ẍ_3`.
+//! Simplified Newton on `Z` with the constant matrix of DESIGN.md section 3
+//! (`∂f/∂x ≈ hR K hRᵀ`, `∂f/∂ẋ ≈ hR D hRᵀ`, `D = α M + β K` the Rayleigh damping):
+//!
+//! `J = h⁻² A⁻² ⊗ M + h⁻¹ A⁻¹ ⊗ D + I ⊗ K`  (rotated by the co-moving frame `R` of stage 3).
+//!
+//! With `T⁻¹ A⁻¹ T = diag(γ, [[α, −β], [β, α]])` (one real eigenvalue `γ ≈ 3.6378` and the
+//! pair `α ± iβ ≈ 2.6811 ± 3.0504 i`) the `3n` system decouples into one real system
+//!
+//! `S_γ = (γ²/h² + α_d γ/h) M + (1 + β_d γ/h) K`  (SPD: sparse Cholesky)
+//!
+//! and one complex one, `S_μ = (μ² + α_d μ) M + (1 + β_d μ) K`, `μ = (α + iβ)/h` (complex
+//! symmetric, indefinite real part: sparse LU over `c64`, [`super::complex_lu`]); `α_d`, `β_d`
+//! are `damping.alpha`, `damping.beta`. Both are factorised once per step size and reused for
+//! the whole run. An iteration: three internal-force evaluations, rotate the residuals into the
+//! frame, transform with `T⁻¹`, one real and one complex solve, transform back with `T`, rotate
+//! back; converged when the largest position correction is below the tolerance.
+//!
+//! Supported: fixed supports and motion interfaces (their nodes are prescribed at the stage
+//! times), damping, stiffening (its `K_G` frozen over the step, in the residual only), `f_nl`
+//! and patches in the residual (iterated, no Woodbury correction). Not supported (an error at
+//! setup): point constraints (pins, hinges: Lagrange multipliers) and the full formulation.
+
+use super::cholesky::{SolveWorkspace, SparseCholesky};
+use super::complex_lu::ComplexLu;
+use super::generalized_alpha::{
+    DynamicState, FreeNodes, IterationSettings, Prescription, StepReport, StepWorkspace,
+};
+use crate::body::frame::{node, set_node};
+use crate::body::Body;
+use crate::error::{Error, Result};
+use faer::c64;
+use nalgebra::{Complex, Matrix3, Vector3};
+
+/// The Radau IIA (s = 3) tableau and the eigen-decomposition of `A⁻¹`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadauIIA {
+    /// Nodes `c = ((4 − √6)/10, (4 + √6)/10, 1)`.
+    pub c: [f64; 3],
+    /// The Runge–Kutta matrix `A`.
+    pub a: Matrix3<f64>,
+    /// `A⁻¹` and `A⁻²`.
+    pub a_inv: Matrix3<f64>,
+    pub a_inv2: Matrix3<f64>,
+    /// `A⁻¹ 𝟙`.
+    pub a_inv_sums: Vector3<f64>,
+    /// `T` with `T⁻¹ A⁻¹ T = diag(γ, [[α, −β], [β, α]])`, and `T⁻¹`.
+    pub t: Matrix3<f64>,
+    pub t_inv: Matrix3<f64>,
+    pub gamma: f64,
+    pub alpha: f64,
+    pub beta: f64,
+}
+
+impl Default for RadauIIA {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl RadauIIA {
+    pub fn new() -> RadauIIA {
+        let s6 = 6.0_f64.sqrt();
+        let a = Matrix3::new(
+            (88.0 - 7.0 * s6) / 360.0,
+            (296.0 - 169.0 * s6) / 1800.0,
+            (-2.0 + 3.0 * s6) / 225.0,
+            (296.0 + 169.0 * s6) / 1800.0,
+            (88.0 + 7.0 * s6) / 360.0,
+            (-2.0 - 3.0 * s6) / 225.0,
+            (16.0 - s6) / 36.0,
+            (16.0 + s6) / 36.0,
+            1.0 / 9.0,
+        );
+        let a_inv = a.try_inverse().expect("the Radau matrix is invertible");
+        let eigenvalues = a_inv.complex_eigenvalues();
+        let (mut gamma, mut lambda) = (0.0, Complex::new(0.0, 0.0));
+        for e in eigenvalues.iter() {
+            if e.im.abs() < 1e-8 {
+                gamma = e.re;
+            } else if e.im < 0.0 {
+                lambda = *e; // α − iβ
+            }
+        }
+        // Null vectors of the rank-2 matrices A⁻¹ − λI: the (bilinear) cross product of two
+        // independent rows.
+        let null_vector = |lambda: Complex<f64>| -> [Complex<f64>; 3] {
+            let row = |i: usize| -> [Complex<f64>; 3] {
+                let mut r = [Complex::new(0.0, 0.0); 3];
+                for (j, v) in r.iter_mut().enumerate() {
+                    *v = Complex::new(a_inv[(i, j)], 0.0)
+                        - if i == j {
+                            lambda
+                        } else {
+                            Complex::new(0.0, 0.0)
+                        };
+                }
+                r
+            };
+            let (p, q) = (row(0), row(1));
+            [
+                p[1] * q[2] - p[2] * q[1],
+                p[2] * q[0] - p[0] * q[2],
+                p[0] * q[1] - p[1] * q[0],
+            ]
+        };
+        let v1 = null_vector(Complex::new(gamma, 0.0));
+        let v2 = null_vector(lambda);
+        let t = Matrix3::new(
+            v1[0].re, v2[0].re, v2[0].im, v1[1].re, v2[1].re, v2[1].im, v1[2].re, v2[2].re,
+            v2[2].im,
+        );
+        let t_inv = t.try_inverse().expect("A⁻¹ is diagonalisable");
+        RadauIIA {
+            c: [(4.0 - s6) / 10.0, (4.0 + s6) / 10.0, 1.0],
+            a,
+            a_inv,
+            a_inv2: a_inv * a_inv,
+            a_inv_sums: a_inv * Vector3::repeat(1.0),
+            t,
+            t_inv,
+            gamma,
+            alpha: lambda.re,
+            beta: -lambda.im,
+        }
+    }
+}
+
+/// The two factorizations of one step size `h`: `S_γ` (real, Cholesky) and `S_μ` (complex, LU).
+pub struct RadauMatrix {
+    pub step_size: f64,
+    pub tableau: RadauIIA,
+    real: SparseCholesky,
+    real_workspace: SolveWorkspace,
+    complex: ComplexLu,
+}
+
+impl RadauMatrix {
+    /// Assembles and factorises `S_γ` and `S_μ` for step `h` on the free DOFs (the only
+    /// factorizations of a run at this `h`). Error for point constraints or the full
+    /// formulation (not supported by this scheme).
+    pub fn new(
+        body: &Body,
+        free: &FreeNodes,
+        tableau: &RadauIIA,
+        h: f64,
+        damping_alpha: f64,
+        damping_beta: f64,
+    ) -> Result<RadauMatrix> {
+        if !free.constraints.is_empty() {
+            return Err(Error::new(
+                "solver.integrator = radauIIA does not support pin or hinge supports (Lagrange-multiplier constraints); use generalizedAlpha",
+            ));
+        }
+        if body.full.is_some() {
+            return Err(Error::new(
+                "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrix is the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+            ));
+        }
+        let g = tableau.gamma / h;
+        let s_real = crate::fem::SymmetricCsr::linear_combination(
+            g * g + damping_alpha * g,
+            &free.mass,
+            1.0 + damping_beta * g,
+            &free.stiffness,
+        );
+        let real = SparseCholesky::new(&s_real)?;
+        let real_workspace = real.solve_scratch();
+        let mu = c64::new(tableau.alpha / h, tableau.beta / h);
+        let complex = ComplexLu::new(
+            mu * mu + mu * damping_alpha,
+            &free.mass,
+            c64::new(1.0, 0.0) + mu * damping_beta,
+            &free.stiffness,
+        )?;
+        Ok(RadauMatrix {
+            step_size: h,
+            tableau: *tableau,
+            real,
+            real_workspace,
+            complex,
+        })
+    }
+
+    /// Stored nonzeros of the real factor (the complex one is about as large, in `c64`).
+    pub fn real_factor_nnz(&self) -> usize {
+        self.real.factor_nnz()
+    }
+}
+
+/// `loads(t, x, f_ext)`: adds the external loads (N) at time `t` (s) and positions `x` (m).
+pub type TimedLoads<'a> = &'a dyn Fn(f64, &[f64], &mut [f64]);
+
+/// What a Radau step needs besides the state: `loads(t, x, f_ext)` adds the external loads at
+/// time `t` to a zeroed `f_ext` (the stages sit at `t_n + c_i h`), `prescribe(t, state)` sets the
+/// clamped nodes' positions, velocities and accelerations at time `t`.
+pub struct RadauProblem<'a> {
+    pub body: &'a Body,
+    pub free: &'a FreeNodes,
+    pub loads: TimedLoads<'a>,
+    pub prescribe: Prescription<'a>,
+}
+
+/// Work vectors of a Radau step (allocated once: a step allocates nothing).
+pub struct RadauWorkspace {
+    /// The three stage states (all nodes; the clamped ones prescribed at the stage times).
+    stages: Vec<DynamicState>,
+    /// Stage increments `Z` on the free DOFs, stage-major (`3 × nf3`).
+    increments: Vec<f64>,
+    /// Rotated stage residuals on the free DOFs (`3 × nf3`), then the corrections.
+    residuals: Vec<f64>,
+    real_rhs: Vec<f64>,
+    complex_rhs: Vec<c64>,
+    external: Vec<f64>,
+    inertia: Vec<f64>,
+    internal: Vec<f64>,
+    previous: DynamicState,
+}
+
+impl RadauWorkspace {
+    pub fn new(body: &Body, free: &FreeNodes) -> RadauWorkspace {
+        let n3 = body.reference.len();
+        let nf3 = free.dof_count();
+        let state = DynamicState {
+            time: 0.0,
+            position: vec![0.0; n3],
+            velocity: vec![0.0; n3],
+            acceleration: vec![0.0; n3],
+            pseudo_acceleration: vec![0.0; n3],
+            multipliers: Vec::new(),
+        };
+        RadauWorkspace {
+            stages: vec![state.clone(), state.clone(), state.clone()],
+            increments: vec![0.0; 3 * nf3],
+            residuals: vec![0.0; 3 * nf3],
+            real_rhs: vec![0.0; nf3],
+            complex_rhs: vec![c64::new(0.0, 0.0); nf3],
+            external: vec![0.0; n3],
+            inertia: vec![0.0; n3],
+            internal: vec![0.0; n3],
+            previous: state,
+        }
+    }
+}
+
+/// One Radau IIA step `t → t + h` of `state`. `forces` provides the force scratch (and the
+/// geometric stiffness of stiffening, if set): after the step it holds `ū`, `g` of stage 3
+/// (`t_{n+1}`). On failure (no convergence in `settings.max_iterations`, non-finite values)
+/// `state` is left as it was and the error is an [`crate::ErrorKind::Discard`].
+pub fn step(
+    problem: &RadauProblem,
+    matrix: &mut RadauMatrix,
+    settings: &IterationSettings,
+    h: f64,
+    state: &mut DynamicState,
+    ws: &mut RadauWorkspace,
+    forces: &mut StepWorkspace,
+) -> Result<StepReport> {
+    ws.previous.copy_from(state);
+    let result = iterate(problem, matrix, settings, h, state, ws, forces);
+    if result.is_err() {
+        state.copy_from(&ws.previous);
+    }
+    result
+}
+
+/// Stage `s`'s free positions, velocities and accelerations from the increments `Z`.
+fn stage_kinematics(
+    tableau: &RadauIIA,
+    free: &FreeNodes,
+    h: f64,
+    s: usize,
+    ws: &mut RadauWorkspace,
+) {
+    let nf3 = free.dof_count();
+    let (prev, z) = (&ws.previous, &ws.increments);
+    let stage = &mut ws.stages[s];
+    let (ai, ai2, sum) = (tableau.a_inv, tableau.a_inv2, tableau.a_inv_sums[s]);
+    for (k, &i) in free.nodes.iter().enumerate() {
+        for d in 0..3 {
+            let (f, g) = (3 * k + d, 3 * i + d);
+            let (z0, z1, z2) = (z[f], z[nf3 + f], z[2 * nf3 + f]);
+            stage.position[g] = prev.position[g] + [z0, z1, z2][s];
+            stage.velocity[g] = (ai[(s, 0)] * z0 + ai[(s, 1)] * z1 + ai[(s, 2)] * z2) / h;
+            stage.acceleration[g] = (ai2[(s, 0)] * z0 + ai2[(s, 1)] * z1 + ai2[(s, 2)] * z2)
+                / (h * h)
+                - sum * prev.velocity[g] / h;
+        }
+    }
+}
+
+fn iterate(
+    problem: &RadauProblem,
+    matrix: &mut RadauMatrix,
+    settings: &IterationSettings,
+    h: f64,
+    state: &mut DynamicState,
+    ws: &mut RadauWorkspace,
+    forces: &mut StepWorkspace,
+) -> Result<StepReport> {
+    let RadauProblem {
+        body,
+        free,
+        loads,
+        prescribe,
+    } = *problem;
+    let tableau = matrix.tableau;
+    let nf3 = free.dof_count();
+    let t0 = ws.previous.time;
+    // Clamped nodes at the stage times; predictor Z_i = c_i h ẋ_n + ½ (c_i h)² ẍ_n.
+    for s in 0..3 {
+        ws.stages[s].copy_from(&ws.previous);
+        ws.stages[s].time = t0 + tableau.c[s] * h;
+        prescribe(ws.stages[s].time, &mut ws.stages[s]);
+        let tau = tableau.c[s] * h;
+        for (k, &i) in free.nodes.iter().enumerate() {
+            for d in 0..3 {
+                let g = 3 * i + d;
+                ws.increments[s * nf3 + 3 * k + d] =
+                    tau * ws.previous.velocity[g] + 0.5 * tau * tau * ws.previous.acceleration[g];
+            }
+        }
+    }
+    let mut last_correction = f64::INFINITY;
+    for iteration in 1..=settings.max_iterations {
+        // Stage residuals r_s = M Ẍ_s + f(X_s, V_s) − f_ext(t_s, X_s) on the free DOFs.
+        let mut rotation = Matrix3::identity();
+        for s in 0..3 {
+            stage_kinematics(&tableau, free, h, s, ws);
+            let stage = &ws.stages[s];
+            let (k_g, scratch) = forces.force_parts();
+            let kin = body.internal_force(
+                &stage.position,
+                &stage.velocity,
+                k_g,
+                scratch,
+                &mut ws.internal,
+            );
+            rotation = kin.frame.rotation;
+            ws.external.fill(0.0);
+            loads(stage.time, &stage.position, &mut ws.external);
+            body.mass_times(&stage.acceleration, &mut ws.inertia);
+            for (k, &i) in free.nodes.iter().enumerate() {
+                for d in 0..3 {
+                    let g = 3 * i + d;
+                    ws.residuals[s * nf3 + 3 * k + d] =
+                        ws.internal[g] + ws.inertia[g] - ws.external[g];
+                }
+            }
+        }
+        // Into the frame of stage 3 (rotation, then T⁻¹ across the stages) and solve.
+        let (rt, ti) = (rotation.transpose(), tableau.t_inv);
+        for k in 0..free.nodes.len() {
+            let r: [Vector3<f64>; 3] =
+                std::array::from_fn(|s| rt * node(&ws.residuals[s * nf3..(s + 1) * nf3], k));
+            let w: [Vector3<f64>; 3] =
+                std::array::from_fn(|m| ti[(m, 0)] * r[0] + ti[(m, 1)] * r[1] + ti[(m, 2)] * r[2]);
+            set_node(&mut ws.real_rhs, k, &w[0]);
+            for (d, value) in ws.complex_rhs[3 * k..3 * k + 3].iter_mut().enumerate() {
+                *value = c64::new(w[1][d], w[2][d]);
+            }
+        }
+        matrix
+            .real
+            .solve_in_place(&mut ws.real_rhs, &mut matrix.real_workspace);
+        matrix.complex.solve_in_place(&mut ws.complex_rhs);
+        // ΔZ = −(T ⊗ hR) δ.
+        let t = tableau.t;
+        let mut largest: f64 = 0.0;
+        for k in 0..free.nodes.len() {
+            let w0 = node(&ws.real_rhs, k);
+            let (mut w1, mut w2) = (Vector3::zeros(), Vector3::zeros());
+            for d in 0..3 {
+                w1[d] = ws.complex_rhs[3 * k + d].re;
+                w2[d] = ws.complex_rhs[3 * k + d].im;
+            }
+            for s in 0..3 {
+                let dz = -(rotation * (t[(s, 0)] * w0 + t[(s, 1)] * w1 + t[(s, 2)] * w2));
+                largest = largest.max(dz.amax());
+                for d in 0..3 {
+                    ws.increments[s * nf3 + 3 * k + d] += dz[d];
+                }
+            }
+        }
+        if !largest.is_finite() {
+            return Err(Error::discard(format!(
+                "radauIIA step to t = {} (h = {h}): the iteration produced a non-finite correction",
+                t0 + h
+            )));
+        }
+        last_correction = largest;
+        if largest <= settings.absolute_tolerance {
+            stage_kinematics(&tableau, free, h, 2, ws);
+            let end = &ws.stages[2];
+            state.time = t0 + h;
+            state.position.copy_from_slice(&end.position);
+            state.velocity.copy_from_slice(&end.velocity);
+            state.acceleration.copy_from_slice(&end.acceleration);
+            state.pseudo_acceleration.copy_from_slice(&end.acceleration);
+            return Ok(StepReport {
+                iterations: iteration,
+                last_correction,
+            });
+        }
+    }
+    Err(Error::discard(format!(
+        "radauIIA step to t = {} (h = {h}) did not converge in {} iterations (last position correction {last_correction:.3e} m, tolerance {:.3e} m)",
+        t0 + h,
+        settings.max_iterations,
+        settings.absolute_tolerance
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tableau_is_radau_iia_and_its_decomposition_is_exact() {
+        let r = RadauIIA::new();
+        // Row sums of A are c (C(1)); A c = c²/2 (C(2)); the last row is b (stiffly accurate).
+        for i in 0..3 {
+            let row: f64 = (0..3).map(|j| r.a[(i, j)]).sum();
+            assert!((row - r.c[i]).abs() < 1e-15);
+            let ac: f64 = (0..3).map(|j| r.a[(i, j)] * r.c[j]).sum();
+            assert!((ac - 0.5 * r.c[i] * r.c[i]).abs() < 1e-15);
+        }
+        // Hairer–Wanner's values of the eigenvalues of A⁻¹.
+        assert!(
+            (r.gamma - 3.637_834_252_744_496).abs() < 1e-12,
+            "{}",
+            r.gamma
+        );
+        assert!(
+            (r.alpha - 2.681_082_873_627_752).abs() < 1e-12,
+            "{}",
+            r.alpha
+        );
+        assert!((r.beta - 3.050_430_199_247_41).abs() < 1e-12, "{}", r.beta);
+        let block = r.t_inv * r.a_inv * r.t;
+        let expected = Matrix3::new(
+            r.gamma, 0.0, 0.0, 0.0, r.alpha, -r.beta, 0.0, r.beta, r.alpha,
+        );
+        assert!((block - expected).amax() < 1e-12, "{block}");
+    }
+}
