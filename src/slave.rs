@@ -25,6 +25,7 @@ use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
     StepWorkspace,
 };
+use crate::solver::radau::{self, RadauIIA, RadauMatrix, RadauProblem, RadauWorkspace};
 use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 
@@ -47,6 +48,7 @@ const STIFFENING_STRESS: i32 = 3;
 /// `solver.integrator` items.
 const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
 const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
+const INTEGRATOR_RADAU: i32 = 3;
 
 /// Most factorizations kept, one per internal step size in use, least recently used evicted.
 ///
@@ -98,7 +100,7 @@ pub struct Parameters {
     pub frames: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
-    /// `solver.integrator`: 1 generalized-α, 2 central difference.
+    /// `solver.integrator`: 1 generalized-α, 2 central difference, 3 Radau IIA.
     pub integrator: i32,
     /// `output.directory`: where VTK results go; empty: none (see [`crate::output`]).
     pub output_directory: String,
@@ -133,6 +135,7 @@ impl Parameters {
             integrator: match b.solver.integrator {
                 Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
                 Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
+                Integrator::RadauIIA => INTEGRATOR_RADAU,
             },
             output_directory: String::new(),
             output_interval: 0.0,
@@ -214,8 +217,19 @@ struct Model {
     mass: ConsistentAcceleration,
     /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
     explicit: Option<CentralDifference>,
+    /// Radau IIA (`solver.integrator = radauIIA`), if chosen: its factorization cache (used in
+    /// place of `matrices`) and workspace. Its residual shares `workspace`'s force scratch and
+    /// geometric stiffness.
+    radau: Option<RadauModel>,
     /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
     strain_monitor: Option<(StrainMonitor, bool)>,
+}
+
+/// Radau IIA's part of the model.
+struct RadauModel {
+    tableau: RadauIIA,
+    matrices: Vec<RadauMatrix>,
+    workspace: RadauWorkspace,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -667,9 +681,12 @@ impl Slave {
     /// Step sizes with a factorization in the cache (at most [`MATRIX_CACHE_SIZE`]), most
     /// recently used last.
     pub fn cached_step_sizes(&self) -> Vec<f64> {
-        self.model.as_ref().map_or_else(Vec::new, |m| {
-            m.matrices.iter().map(|x| x.step_size).collect()
-        })
+        self.model
+            .as_ref()
+            .map_or_else(Vec::new, |m| match &m.radau {
+                Some(radau) => radau.matrices.iter().map(|x| x.step_size).collect(),
+                None => m.matrices.iter().map(|x| x.step_size).collect(),
+            })
     }
 
     /// Internal steps that did not converge and were retried with halved steps (each retry
@@ -1416,17 +1433,37 @@ impl Slave {
             loads: &loads,
             prescribe: &prescribe,
         };
+        // Radau's stages sit inside the step: its loads take the time.
+        let timed_loads = |t: f64, x: &[f64], f: &mut [f64]| {
+            tau.set(t - t_c);
+            loads(x, f)
+        };
+        let radau_problem = RadauProblem {
+            body,
+            free: &model.free,
+            loads: &timed_loads,
+            prescribe: &prescribe,
+        };
         for j in 0..m {
             tau.set(if last_of_step && j + 1 == m {
                 big_h
             } else {
                 tau0 + (j + 1) as f64 * hs
             });
-            let report = match &model.explicit {
-                Some(explicit) => {
+            let report = match (&model.explicit, &mut model.radau) {
+                (Some(explicit), _) => {
                     explicit.step(&problem, hs, &mut dynamics.state, &mut model.workspace)?
                 }
-                None => generalized_alpha::step(
+                (None, Some(radau)) => radau::step(
+                    &radau_problem,
+                    &mut radau.matrices[index],
+                    &settings,
+                    hs,
+                    &mut dynamics.state,
+                    &mut radau.workspace,
+                    &mut model.workspace,
+                )?,
+                (None, None) => generalized_alpha::step(
                     &problem,
                     &mut model.matrices[index],
                     &settings,
@@ -1552,8 +1589,36 @@ impl Slave {
         } else {
             None
         };
+        let radau = if p.integrator == INTEGRATOR_RADAU {
+            // Radau's constant matrices have no Schur complement for Lagrange multipliers and
+            // no tangent for the full formulation: refuse them here, by name.
+            if let Some(k) = self
+                .interfaces
+                .iter()
+                .position(|i| !i.point_constraints.is_empty())
+            {
+                return Err(Error::new(format!(
+                    "solver.integrator = radauIIA: interface '{}' is a {} support, a Lagrange-multiplier constraint that this scheme does not support; use generalizedAlpha, or a fixed support",
+                    self.body_file.interfaces[k].name,
+                    if self.interfaces[k].kind == InterfaceKind::Pin { "pin" } else { "hinge" }
+                )));
+            }
+            if p.formulation == FORMULATION_FULL {
+                return Err(Error::new(
+                    "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+                ));
+            }
+            Some(RadauModel {
+                tableau: RadauIIA::new(),
+                matrices: Vec::new(),
+                workspace: RadauWorkspace::new(&body, &free),
+            })
+        } else {
+            None
+        };
         self.model = Some(Model {
             key,
+            radau,
             body,
             scheme: GeneralizedAlpha::new(p.rho_inf),
             matrices: Vec::new(),
@@ -1577,6 +1642,38 @@ impl Slave {
         let model = self.model.as_mut().unwrap();
         if model.explicit.is_some() {
             return Ok(usize::MAX); // the explicit scheme factorises nothing
+        }
+        if let Some(radau) = &mut model.radau {
+            if let Some(i) = radau
+                .matrices
+                .iter()
+                .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
+            {
+                radau.matrices[i..].rotate_left(1);
+                return Ok(radau.matrices.len() - 1);
+            }
+            let started = std::time::Instant::now();
+            let matrix = RadauMatrix::new(
+                &model.body,
+                &model.free,
+                &radau.tableau,
+                h,
+                p.damping_alpha,
+                p.damping_beta,
+            )?;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "factorised the Radau IIA matrices for internal step h = {h:e} s: real Cholesky nnz(L) = {} and complex LU ({:.3} s); they serve every step of this size",
+                    matrix.real_factor_nnz(),
+                    started.elapsed().as_secs_f64()
+                ),
+            });
+            if radau.matrices.len() >= MATRIX_CACHE_SIZE {
+                radau.matrices.remove(0);
+            }
+            radau.matrices.push(matrix);
+            return Ok(radau.matrices.len() - 1);
         }
         if let Some(i) = model
             .matrices
