@@ -285,6 +285,8 @@ pub struct Slave {
     /// Node sets, and `clamped[i]` for nodes held by a `fixed` support.
     interfaces: Vec<Interface>,
     clamped: Vec<bool>,
+    /// The material region of each element (`BodyFile::regions`), `None`: `material.*`.
+    element_regions: Vec<Option<usize>>,
     /// Characteristic size of the body (m): the diagonal of its bounding box.
     size: f64,
     defaults: Parameters,
@@ -398,6 +400,7 @@ impl Slave {
                 }
             }
         }
+        let element_regions = body_file.element_regions(&mesh)?;
         let guid = guid_of(&body_file);
         let n_interfaces = interfaces.len();
         // Motion interfaces start at their place in the body file, at rest.
@@ -422,6 +425,7 @@ impl Slave {
             mesh,
             interfaces,
             clamped,
+            element_regions,
             size,
             parameters: defaults.clone(),
             defaults,
@@ -1500,11 +1504,42 @@ impl Slave {
         p.material.validate()?;
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
         // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
-        let lumped = fem::lumped_masses(&self.mesh, p.material.density);
+        // Material regions: each element's material (the body's outside every region).
+        let regions = &self.body_file.regions;
+        if !regions.is_empty() {
+            let unsupported = if p.formulation == FORMULATION_FULL {
+                Some("model.formulation = full")
+            } else if p.stiffening != 1 {
+                Some("model.stiffening other than none")
+            } else if p.frames > 1 {
+                Some("model.frames > 1")
+            } else if !p.output_directory.is_empty() {
+                Some("output.directory (the stress output uses one material)")
+            } else {
+                None
+            };
+            if let Some(what) = unsupported {
+                return Err(Error::new(format!(
+                    "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
+                    regions[0].name,
+                    if regions.len() > 1 { ", ..." } else { "" }
+                )));
+            }
+        }
+        let element_material = |e: usize| match self.element_regions[e] {
+            Some(k) => IsotropicMaterial {
+                youngs_modulus: regions[k].youngs_modulus,
+                poisson_ratio: p.material.poisson_ratio,
+                density: regions[k].density.unwrap_or(p.material.density),
+            },
+            None => p.material,
+        };
+        let density = |e: usize| element_material(e).density;
+        let lumped = fem::lumped_masses_of(&self.mesh, &density);
         let body = Body::new(
             reference,
-            fem::scalar_mass_matrix(&self.mesh, p.material.density),
-            fem::stiffness_matrix(&self.mesh, &p.material),
+            fem::scalar_mass_matrix_of(&self.mesh, &density),
+            fem::stiffness_matrix_of(&self.mesh, &element_material),
             lumped.clone(),
             BodyOptions {
                 nonlinear_forces: p.nonlinear_forces,
