@@ -1646,7 +1646,11 @@ impl Slave {
             Some(RadauModel {
                 tableau: RadauIIA::new(),
                 matrices: Vec::new(),
-                workspace: RadauWorkspace::new(&body, &free),
+                workspace: RadauWorkspace::with_anderson_depth(
+                    &body,
+                    &free,
+                    p.anderson_depth as usize,
+                ),
             })
         } else {
             None
