@@ -20,6 +20,11 @@ fn do_step_does_not_allocate_after_the_first_step() {
     // Radau IIA: the real Cholesky and the complex LU solves take their workspaces.
     steps_do_not_allocate(&[("solver.integrator", 3.0)]);
     steps_do_not_allocate(&[("solver.integrator", 3.0), ("model.stiffening", 2.0)]);
+    steps_do_not_allocate(&[
+        ("solver.integrator", 3.0),
+        ("model.nonlinearForces", 1.0),
+        ("model.frames", 5.0),
+    ]);
 }
 
 /// Steps of the default body with damping, gravity, a tip load and `settings`.
