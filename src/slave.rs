@@ -56,7 +56,10 @@ const INTEGRATOR_RADAU: i32 = 3;
 /// its solve workspace (and, with pins or hinges, the small dense Schur complement). For the
 /// default body (621 nodes, 1 800 free DOF) the factor holds 223 083 values (1.8 MB, about 3 MB
 /// with its indices); the cache is bounded by four of them whatever sequence of communication
-/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound).
+/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound). With
+/// `radauIIA` an entry holds that Cholesky factor and a complex (`c64`) LU factor of the same
+/// matrix size besides (pivoting, COLAMD ordering: it is larger; factorization measured 3–6 ×
+/// the Cholesky's time), so a Radau entry costs several times a generalized-α one.
 /// Four covers a steady step size, a last partial step and the three step sizes of the retries
 /// of a failed internal step ([`MAX_STEP_HALVINGS`]); a fifth size evicts the least recently used
 /// one, which is factorised again when it comes back.
