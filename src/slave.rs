@@ -1628,19 +1628,8 @@ impl Slave {
             None
         };
         let radau = if p.integrator == INTEGRATOR_RADAU {
-            // Radau's constant matrices have no Schur complement for Lagrange multipliers and
-            // no tangent for the full formulation: refuse them here, by name.
-            if let Some(k) = self
-                .interfaces
-                .iter()
-                .position(|i| !i.point_constraints.is_empty())
-            {
-                return Err(Error::new(format!(
-                    "solver.integrator = radauIIA: interface '{}' is a {} support, a Lagrange-multiplier constraint that this scheme does not support; use generalizedAlpha, or a fixed support",
-                    self.body_file.interfaces[k].name,
-                    if self.interfaces[k].kind == InterfaceKind::Pin { "pin" } else { "hinge" }
-                )));
-            }
+            // Radau's constant matrices hold the rotated small-strain stiffness: no tangent for
+            // the full formulation.
             if p.formulation == FORMULATION_FULL {
                 return Err(Error::new(
                     "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",

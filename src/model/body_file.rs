@@ -211,7 +211,7 @@ pub enum Integrator {
     /// Explicit central difference with the lumped mass, the step limited by `2/ω_max`.
     CentralDifference,
     /// Implicit Radau IIA (3 stages, order 5, L-stable): one real and one complex constant
-    /// factorization per step size (`solver::radau`); no pin or hinge supports.
+    /// factorization per step size (`solver::radau`); reduced-strain formulation only.
     #[serde(rename = "radauIIA")]
     RadauIIA,
 }

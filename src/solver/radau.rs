@@ -39,12 +39,18 @@
 //!
 //! Supported: fixed supports and motion interfaces (their nodes are prescribed at the stage
 //! times), damping, stiffening (its `K_G` frozen over the step, in the residual only), `f_nl`
-//! and patches in the residual (iterated, no Woodbury correction). Not supported (an error at
-//! setup): point constraints (pins, hinges: Lagrange multipliers) and the full formulation.
+//! and patches in the residual (iterated, no Woodbury correction), and point constraints (pins,
+//! hinges): the stage multipliers `Λ_s` are transformed with `T` like the increments, and each
+//! block system `[[S_k, Cᵀ], [C, 0]]` is solved through its constant Schur complement
+//! `C S_k⁻¹ Cᵀ` (real for `S_γ`, complex for `S_μ`; `C = ŵ ⊗ I3` commutes with the stage
+//! rotations, [`super::constraints`]), so that `C X_s = d` holds at every stage to the
+//! iteration tolerance (index 3, no drift). Not supported (an error at setup): the full
+//! formulation (its tangent is not the rotated constant `K`).
 
 use super::anderson::Anderson;
 use super::cholesky::{SolveWorkspace, SparseCholesky};
 use super::complex_lu::ComplexLu;
+use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
 use super::generalized_alpha::{
     DynamicState, FreeNodes, IterationSettings, Prescription, StepReport, StepWorkspace,
     DEFAULT_ANDERSON_DEPTH,
@@ -53,7 +59,7 @@ use crate::body::frame::{node, set_node};
 use crate::body::Body;
 use crate::error::{Error, Result};
 use faer::c64;
-use nalgebra::{Complex, Matrix3, Vector3};
+use nalgebra::{Complex, DMatrix, Matrix3, Vector3};
 
 /// The Radau IIA (s = 3) tableau and the eigen-decomposition of `A⁻¹`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,12 +162,81 @@ pub struct RadauMatrix {
     real: SparseCholesky,
     real_workspace: SolveWorkspace,
     complex: ComplexLu,
+    /// With point constraints (pins, hinges): the Schur complements of both blocks.
+    constraints: Option<StageConstraints>,
+}
+
+/// The point constraints' part of the two block systems `[[S_k, Cᵀ], [C, 0]]`: `Z_k = S_k⁻¹ Cᵀ`
+/// (free DOFs × 3m, column-major) and `(C Z_k)⁻¹` for the real block `S_γ` and the complex
+/// block `S_μ` (the constant selection Jacobian `C = ŵ ⊗ I3` commutes with the rotations, see
+/// [`super::constraints`]). Block `k`'s constrained solution of `S_k y + Cᵀ μ = w`, `C y = q`
+/// is `μ = (C Z_k)⁻¹ (C S_k⁻¹ w − q)`, `y = S_k⁻¹ w − Z_k μ`.
+struct StageConstraints {
+    real: ConstraintFactor,
+    complex_z: Vec<c64>,
+    complex_schur_inverse: DMatrix<c64>,
+    /// Scratch (3m each): real and complex `C S⁻¹ w − q`, then `μ`.
+    real_error: Vec<f64>,
+    real_mu: Vec<f64>,
+    complex_error: Vec<c64>,
+    complex_mu: Vec<c64>,
+}
+
+impl StageConstraints {
+    fn new(
+        constraints: &[PointConstraint],
+        real: &SparseCholesky,
+        workspace: &mut SolveWorkspace,
+        complex: &mut ComplexLu,
+    ) -> Result<StageConstraints> {
+        let real_factor = ConstraintFactor::new(constraints, real, workspace)?;
+        let n = complex.dim();
+        let m = 3 * constraints.len();
+        let mut z = vec![c64::new(0.0, 0.0); n * m];
+        for (p, c) in constraints.iter().enumerate() {
+            for d in 0..3 {
+                let column = &mut z[(3 * p + d) * n..(3 * p + d + 1) * n];
+                for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
+                    column[row + d] = c64::new(w, 0.0);
+                }
+                complex.solve_in_place(column);
+            }
+        }
+        let mut a = DMatrix::from_element(m, m, c64::new(0.0, 0.0));
+        for col in 0..m {
+            let column = &z[col * n..(col + 1) * n];
+            for (q, c) in constraints.iter().enumerate() {
+                for e in 0..3 {
+                    a[(3 * q + e, col)] = c
+                        .free_rows
+                        .iter()
+                        .zip(&c.weights)
+                        .map(|(&row, &w)| column[row + e] * w)
+                        .sum();
+                }
+            }
+        }
+        let complex_schur_inverse = a.try_inverse().ok_or_else(|| {
+            Error::new(
+                "radauIIA: the pin/hinge constraints are redundant (the complex Schur complement is singular)",
+            )
+        })?;
+        Ok(StageConstraints {
+            real: real_factor,
+            complex_z: z,
+            complex_schur_inverse,
+            real_error: vec![0.0; m],
+            real_mu: vec![0.0; m],
+            complex_error: vec![c64::new(0.0, 0.0); m],
+            complex_mu: vec![c64::new(0.0, 0.0); m],
+        })
+    }
 }
 
 impl RadauMatrix {
     /// Assembles and factorises `S_γ` and `S_μ` for step `h` on the free DOFs (the only
-    /// factorizations of a run at this `h`). Error for point constraints or the full
-    /// formulation (not supported by this scheme).
+    /// factorizations of a run at this `h`), with the Schur complements of the point
+    /// constraints if any. Error for the full formulation (not supported by this scheme).
     pub fn new(
         body: &Body,
         free: &FreeNodes,
@@ -170,11 +245,6 @@ impl RadauMatrix {
         damping_alpha: f64,
         damping_beta: f64,
     ) -> Result<RadauMatrix> {
-        if !free.constraints.is_empty() {
-            return Err(Error::new(
-                "solver.integrator = radauIIA does not support pin or hinge supports (Lagrange-multiplier constraints); use generalizedAlpha",
-            ));
-        }
         if body.full.is_some() {
             return Err(Error::new(
                 "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrix is the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
@@ -190,18 +260,30 @@ impl RadauMatrix {
         let real = SparseCholesky::new(&s_real)?;
         let real_workspace = real.solve_scratch();
         let mu = c64::new(tableau.alpha / h, tableau.beta / h);
-        let complex = ComplexLu::new(
+        let mut complex = ComplexLu::new(
             mu * mu + mu * damping_alpha,
             &free.mass,
             c64::new(1.0, 0.0) + mu * damping_beta,
             &free.stiffness,
         )?;
+        let mut real_workspace = real_workspace;
+        let constraints = if free.constraints.is_empty() {
+            None
+        } else {
+            Some(StageConstraints::new(
+                &free.constraints,
+                &real,
+                &mut real_workspace,
+                &mut complex,
+            )?)
+        };
         Ok(RadauMatrix {
             step_size: h,
             tableau: *tableau,
             real,
             real_workspace,
             complex,
+            constraints,
         })
     }
 
@@ -228,11 +310,13 @@ pub struct RadauProblem<'a> {
 pub struct RadauWorkspace {
     /// The three stage states (all nodes; the clamped ones prescribed at the stage times).
     stages: Vec<DynamicState>,
-    /// Stage increments `Z` on the free DOFs, stage-major (`3 × nf3`).
+    /// The iterate: stage increments `Z` on the free DOFs, stage-major (`3 × nf3`), then the
+    /// stage multipliers `Λ` (`3 × 3m`, global) of the point constraints.
     increments: Vec<f64>,
     /// Stage residuals on the free DOFs (`3 × nf3`).
     residuals: Vec<f64>,
-    /// The correction `ΔZ` of an iteration (`3 × nf3`) and Anderson's acceleration of it.
+    /// The correction `[ΔZ, ΔΛ]` of an iteration and Anderson's acceleration of it (fitted on
+    /// `ΔZ`, in metres).
     update: Vec<f64>,
     anderson: Anderson,
     real_rhs: Vec<f64>,
@@ -254,20 +338,21 @@ impl RadauWorkspace {
     pub fn with_anderson_depth(body: &Body, free: &FreeNodes, depth: usize) -> RadauWorkspace {
         let n3 = body.reference.len();
         let nf3 = free.dof_count();
+        let nm = free.multiplier_count();
         let state = DynamicState {
             time: 0.0,
             position: vec![0.0; n3],
             velocity: vec![0.0; n3],
             acceleration: vec![0.0; n3],
             pseudo_acceleration: vec![0.0; n3],
-            multipliers: Vec::new(),
+            multipliers: vec![0.0; nm],
         };
         RadauWorkspace {
             stages: vec![state.clone(), state.clone(), state.clone()],
-            increments: vec![0.0; 3 * nf3],
+            increments: vec![0.0; 3 * nf3 + 3 * nm],
             residuals: vec![0.0; 3 * nf3],
-            update: vec![0.0; 3 * nf3],
-            anderson: Anderson::new(depth, 3 * nf3, 3 * nf3),
+            update: vec![0.0; 3 * nf3 + 3 * nm],
+            anderson: Anderson::new(depth, 3 * nf3 + 3 * nm, 3 * nf3),
             real_rhs: vec![0.0; nf3],
             complex_rhs: vec![c64::new(0.0, 0.0); nf3],
             external: vec![0.0; n3],
@@ -357,6 +442,12 @@ fn iterate(
             }
         }
     }
+    // Stage multipliers: Λ_s = λ_n.
+    let nm = free.multiplier_count();
+    for s in 0..3 {
+        let start = 3 * nf3 + s * nm;
+        ws.increments[start..start + nm].copy_from_slice(&ws.previous.multipliers);
+    }
     let mut last_correction = f64::INFINITY;
     ws.anderson.reset();
     for iteration in 1..=settings.max_iterations {
@@ -374,6 +465,12 @@ fn iterate(
                 &mut ws.internal,
             );
             *stage_rotation = kin.frame.rotation;
+            let start = 3 * nf3 + s * nm;
+            add_constraint_forces(
+                &free.constraints,
+                &ws.increments[start..start + nm],
+                &mut ws.internal,
+            );
             ws.external.fill(0.0);
             loads(stage.time, &stage.position, &mut ws.external);
             body.mass_times(&stage.acceleration, &mut ws.inertia);
@@ -402,6 +499,67 @@ fn iterate(
             .real
             .solve_in_place(&mut ws.real_rhs, &mut matrix.real_workspace);
         matrix.complex.solve_in_place(&mut ws.complex_rhs);
+        if let Some(sc) = &mut matrix.constraints {
+            // Constraint errors g_s = C X_s − d in the stage frames, T⁻¹ across the stages:
+            // q_k; then μ_k = (C Z_k)⁻¹ (C S_k⁻¹ w_k − q_k), y_k = S_k⁻¹ w_k − Z_k μ_k.
+            for (p, c) in free.constraints.iter().enumerate() {
+                let g: [Vector3<f64>; 3] = std::array::from_fn(|s| {
+                    rotation[s].transpose() * (c.centroid(&ws.stages[s].position) - c.target)
+                });
+                let q: [Vector3<f64>; 3] = std::array::from_fn(|m| {
+                    ti[(m, 0)] * g[0] + ti[(m, 1)] * g[1] + ti[(m, 2)] * g[2]
+                });
+                let (mut cy_real, mut cy_complex) =
+                    (Vector3::<f64>::zeros(), [c64::new(0.0, 0.0); 3]);
+                for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
+                    for d in 0..3 {
+                        cy_real[d] += w * ws.real_rhs[row + d];
+                        cy_complex[d] += ws.complex_rhs[row + d] * w;
+                    }
+                }
+                for d in 0..3 {
+                    sc.real_error[3 * p + d] = cy_real[d] - q[0][d];
+                    sc.complex_error[3 * p + d] = cy_complex[d] - c64::new(q[1][d], q[2][d]);
+                }
+            }
+            let m = sc.real_error.len();
+            for i in 0..m {
+                sc.real_mu[i] = (0..m)
+                    .map(|j| sc.real.schur_inverse[(i, j)] * sc.real_error[j])
+                    .sum();
+                sc.complex_mu[i] = (0..m)
+                    .map(|j| sc.complex_schur_inverse[(i, j)] * sc.complex_error[j])
+                    .sum();
+            }
+            let n = nf3;
+            for col in 0..m {
+                let (mu_r, mu_c) = (sc.real_mu[col], sc.complex_mu[col]);
+                let zr = &sc.real.z[col * n..(col + 1) * n];
+                for (y, z) in ws.real_rhs.iter_mut().zip(zr) {
+                    *y -= z * mu_r;
+                }
+                let zc = &sc.complex_z[col * n..(col + 1) * n];
+                for (y, z) in ws.complex_rhs.iter_mut().zip(zc) {
+                    *y -= z * mu_c;
+                }
+            }
+            // ΔΛ_s = −R_s Σ_k T_sk μ_k (per constraint).
+            let t = tableau.t;
+            for p in 0..free.constraints.len() {
+                let mu0 = Vector3::new(
+                    sc.real_mu[3 * p],
+                    sc.real_mu[3 * p + 1],
+                    sc.real_mu[3 * p + 2],
+                );
+                let mu1 = Vector3::from_fn(|d, _| sc.complex_mu[3 * p + d].re);
+                let mu2 = Vector3::from_fn(|d, _| sc.complex_mu[3 * p + d].im);
+                for s in 0..3 {
+                    let dl = -(rotation[s] * (t[(s, 0)] * mu0 + t[(s, 1)] * mu1 + t[(s, 2)] * mu2));
+                    let start = 3 * nf3 + s * nm + 3 * p;
+                    ws.update[start..start + 3].copy_from_slice(dl.as_slice());
+                }
+            }
+        }
         // ΔZ_s = −R_s Σ_k T_sk δ_k.
         let t = tableau.t;
         let mut largest: f64 = 0.0;
@@ -443,6 +601,9 @@ fn iterate(
             state.velocity.copy_from_slice(&end.velocity);
             state.acceleration.copy_from_slice(&end.acceleration);
             state.pseudo_acceleration.copy_from_slice(&end.acceleration);
+            state
+                .multipliers
+                .copy_from_slice(&ws.increments[3 * nf3 + 2 * nm..3 * nf3 + 3 * nm]);
             return Ok(StepReport {
                 iterations: iteration,
                 last_correction,
