@@ -139,6 +139,17 @@ fn bad_regions_are_refused_by_name() {
         "{}",
         e.message
     );
+    // Combinations that would use one material somewhere are refused at initialization.
+    let mut s = Slave::from_body(body(1.0, 20, Some(0.5))).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.frames", 2.0);
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(
+        e.message.contains("'stiff'") && e.message.contains("model.frames"),
+        "{}",
+        e.message
+    );
 }
 
 /// Energy `KE + SE` against the work `F·Δp_tip` of the constant tip load, sampled every
