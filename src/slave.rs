@@ -25,6 +25,7 @@ use crate::solver::generalized_alpha::{
     self, DynamicState, FreeNodes, GeneralizedAlpha, IterationMatrix, IterationSettings,
     StepWorkspace,
 };
+use crate::solver::radau::{self, RadauIIA, RadauMatrix, RadauProblem, RadauWorkspace};
 use nalgebra::{Matrix3, Vector3};
 use std::path::Path;
 
@@ -48,6 +49,7 @@ const STIFFENING_STRESS: i32 = 3;
 /// `solver.integrator` items.
 const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
 const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
+const INTEGRATOR_RADAU: i32 = 3;
 
 /// Most factorizations kept, one per internal step size in use, least recently used evicted.
 ///
@@ -55,7 +57,10 @@ const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
 /// its solve workspace (and, with pins or hinges, the small dense Schur complement). For the
 /// default body (621 nodes, 1 800 free DOF) the factor holds 223 083 values (1.8 MB, about 3 MB
 /// with its indices); the cache is bounded by four of them whatever sequence of communication
-/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound).
+/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound). With
+/// `radauIIA` an entry holds that Cholesky factor and a complex (`c64`) LU factor of the same
+/// matrix size besides (pivoting, COLAMD ordering: it is larger; factorization measured 3–6 ×
+/// the Cholesky's time), so a Radau entry costs several times a generalized-α one.
 /// Four covers a steady step size, a last partial step and the three step sizes of the retries
 /// of a failed internal step ([`MAX_STEP_HALVINGS`]); a fifth size evicts the least recently used
 /// one, which is factorised again when it comes back.
@@ -101,7 +106,7 @@ pub struct Parameters {
     pub modes: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
-    /// `solver.integrator`: 1 generalized-α, 2 central difference.
+    /// `solver.integrator`: 1 generalized-α, 2 central difference, 3 Radau IIA.
     pub integrator: i32,
     /// `output.directory`: where VTK results go; empty: none (see [`crate::output`]).
     pub output_directory: String,
@@ -137,6 +142,7 @@ impl Parameters {
             integrator: match b.solver.integrator {
                 Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
                 Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
+                Integrator::RadauIIA => INTEGRATOR_RADAU,
             },
             output_directory: String::new(),
             output_interval: 0.0,
@@ -222,8 +228,19 @@ struct Model {
     mass: ConsistentAcceleration,
     /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
     explicit: Option<CentralDifference>,
+    /// Radau IIA (`solver.integrator = radauIIA`), if chosen: its factorization cache (used in
+    /// place of `matrices`) and workspace. Its residual shares `workspace`'s force scratch and
+    /// geometric stiffness.
+    radau: Option<RadauModel>,
     /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
     strain_monitor: Option<(StrainMonitor, bool)>,
+}
+
+/// Radau IIA's part of the model.
+struct RadauModel {
+    tableau: RadauIIA,
+    matrices: Vec<RadauMatrix>,
+    workspace: RadauWorkspace,
 }
 
 /// The motion state and the loads it is in equilibrium with.
@@ -279,6 +296,8 @@ pub struct Slave {
     /// Node sets, and `clamped[i]` for nodes held by a `fixed` support.
     interfaces: Vec<Interface>,
     clamped: Vec<bool>,
+    /// The material region of each element (`BodyFile::regions`), `None`: `material.*`.
+    element_regions: Vec<Option<usize>>,
     /// Characteristic size of the body (m): the diagonal of its bounding box.
     size: f64,
     defaults: Parameters,
@@ -392,6 +411,7 @@ impl Slave {
                 }
             }
         }
+        let element_regions = body_file.element_regions(&mesh)?;
         let guid = guid_of(&body_file);
         let n_interfaces = interfaces.len();
         // Motion interfaces start at their place in the body file, at rest.
@@ -416,6 +436,7 @@ impl Slave {
             mesh,
             interfaces,
             clamped,
+            element_regions,
             size,
             parameters: defaults.clone(),
             defaults,
@@ -675,9 +696,12 @@ impl Slave {
     /// Step sizes with a factorization in the cache (at most [`MATRIX_CACHE_SIZE`]), most
     /// recently used last.
     pub fn cached_step_sizes(&self) -> Vec<f64> {
-        self.model.as_ref().map_or_else(Vec::new, |m| {
-            m.matrices.iter().map(|x| x.step_size).collect()
-        })
+        self.model
+            .as_ref()
+            .map_or_else(Vec::new, |m| match &m.radau {
+                Some(radau) => radau.matrices.iter().map(|x| x.step_size).collect(),
+                None => m.matrices.iter().map(|x| x.step_size).collect(),
+            })
     }
 
     /// Internal steps that did not converge and were retried with halved steps (each retry
@@ -1446,17 +1470,37 @@ impl Slave {
             loads: &loads,
             prescribe: &prescribe,
         };
+        // Radau's stages sit inside the step: its loads take the time.
+        let timed_loads = |t: f64, x: &[f64], f: &mut [f64]| {
+            tau.set(t - t_c);
+            loads(x, f)
+        };
+        let radau_problem = RadauProblem {
+            body,
+            free: &model.free,
+            loads: &timed_loads,
+            prescribe: &prescribe,
+        };
         for j in 0..m {
             tau.set(if last_of_step && j + 1 == m {
                 big_h
             } else {
                 tau0 + (j + 1) as f64 * hs
             });
-            let report = match &model.explicit {
-                Some(explicit) => {
+            let report = match (&model.explicit, &mut model.radau) {
+                (Some(explicit), _) => {
                     explicit.step(&problem, hs, &mut dynamics.state, &mut model.workspace)?
                 }
-                None => generalized_alpha::step(
+                (None, Some(radau)) => radau::step(
+                    &radau_problem,
+                    &mut radau.matrices[index],
+                    &settings,
+                    hs,
+                    &mut dynamics.state,
+                    &mut radau.workspace,
+                    &mut model.workspace,
+                )?,
+                (None, None) => generalized_alpha::step(
                     &problem,
                     &mut model.matrices[index],
                     &settings,
@@ -1493,14 +1537,45 @@ impl Slave {
         p.material.validate()?;
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
         // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
-        let lumped = fem::lumped_masses(&self.mesh, p.material.density);
+        // Material regions: each element's material (the body's outside every region).
+        let regions = &self.body_file.regions;
+        if !regions.is_empty() {
+            let unsupported = if p.formulation == FORMULATION_FULL {
+                Some("model.formulation = full")
+            } else if p.stiffening != 1 {
+                Some("model.stiffening other than none")
+            } else if p.frames > 1 {
+                Some("model.frames > 1")
+            } else if !p.output_directory.is_empty() {
+                Some("output.directory (the stress output uses one material)")
+            } else {
+                None
+            };
+            if let Some(what) = unsupported {
+                return Err(Error::new(format!(
+                    "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
+                    regions[0].name,
+                    if regions.len() > 1 { ", ..." } else { "" }
+                )));
+            }
+        }
+        let element_material = |e: usize| match self.element_regions[e] {
+            Some(k) => IsotropicMaterial {
+                youngs_modulus: regions[k].youngs_modulus,
+                poisson_ratio: p.material.poisson_ratio,
+                density: regions[k].density.unwrap_or(p.material.density),
+            },
+            None => p.material,
+        };
+        let density = |e: usize| element_material(e).density;
+        let lumped = fem::lumped_masses_of(&self.mesh, &density);
         let options = BodyOptions {
             nonlinear_forces: p.nonlinear_forces,
             damping_alpha: p.damping_alpha,
             damping_beta: p.damping_beta,
         };
-        let mass_matrix = fem::scalar_mass_matrix(&self.mesh, p.material.density);
-        let stiffness_matrix = fem::stiffness_matrix(&self.mesh, &p.material);
+        let mass_matrix = fem::scalar_mass_matrix_of(&self.mesh, &density);
+        let stiffness_matrix = fem::stiffness_matrix_of(&self.mesh, &element_material);
         if p.modes > 0 {
             self.check_reducible()?;
             let p = &self.parameters;
@@ -1716,8 +1791,29 @@ impl Slave {
         };
         let monitored =
             p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
+        let radau = if p.integrator == INTEGRATOR_RADAU {
+            // Radau's constant matrices hold the rotated small-strain stiffness: no tangent for
+            // the full formulation.
+            if p.formulation == FORMULATION_FULL {
+                return Err(Error::new(
+                    "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+                ));
+            }
+            Some(RadauModel {
+                tableau: RadauIIA::new(),
+                matrices: Vec::new(),
+                workspace: RadauWorkspace::with_anderson_depth(
+                    &body,
+                    &free,
+                    p.anderson_depth as usize,
+                ),
+            })
+        } else {
+            None
+        };
         self.model = Some(Model {
             key,
+            radau,
             body,
             scheme: GeneralizedAlpha::new(p.rho_inf),
             matrices: Vec::new(),
@@ -1743,6 +1839,38 @@ impl Slave {
         let model = self.model.as_mut().unwrap();
         if model.explicit.is_some() {
             return Ok(usize::MAX); // the explicit scheme factorises nothing
+        }
+        if let Some(radau) = &mut model.radau {
+            if let Some(i) = radau
+                .matrices
+                .iter()
+                .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
+            {
+                radau.matrices[i..].rotate_left(1);
+                return Ok(radau.matrices.len() - 1);
+            }
+            let started = std::time::Instant::now();
+            let matrix = RadauMatrix::new(
+                &model.body,
+                &model.free,
+                &radau.tableau,
+                h,
+                p.damping_alpha,
+                p.damping_beta,
+            )?;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "factorised the Radau IIA matrices for internal step h = {h:e} s: real Cholesky nnz(L) = {} and complex LU ({:.3} s); they serve every step of this size",
+                    matrix.real_factor_nnz(),
+                    started.elapsed().as_secs_f64()
+                ),
+            });
+            if radau.matrices.len() >= MATRIX_CACHE_SIZE {
+                radau.matrices.remove(0);
+            }
+            radau.matrices.push(matrix);
+            return Ok(radau.matrices.len() - 1);
         }
         if let Some(i) = model
             .matrices

@@ -18,6 +18,46 @@ fn do_step_does_not_allocate_after_the_first_step() {
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.frames", 5.0)]);
     steps_do_not_allocate(&[("solver.andersonDepth", 0.0)]);
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.modes", 4.0)]);
+    // Radau IIA: the real Cholesky and the complex LU solves take their workspaces.
+    steps_do_not_allocate(&[("solver.integrator", 3.0)]);
+    steps_do_not_allocate(&[("solver.integrator", 3.0), ("model.stiffening", 2.0)]);
+    steps_do_not_allocate(&[
+        ("solver.integrator", 3.0),
+        ("model.nonlinearForces", 1.0),
+        ("model.frames", 5.0),
+    ]);
+    pinned_radau_steps_do_not_allocate();
+}
+
+/// Radau with a pin: the stage multipliers and both Schur complements (real and complex).
+fn pinned_radau_steps_do_not_allocate() {
+    let body = flexbody::model::BodyFile::from_json(
+        r#"{
+  "name": "pendulum",
+  "mesh": { "beam": { "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" } },
+  "material": { "youngsModulus": 2.1e11, "poissonRatio": 0.3, "density": 7850.0 },
+  "interfaces": [
+    { "name": "pivot", "kind": "pin", "nodes": { "plane": { "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } } }
+  ],
+  "solver": { "integrator": "radauIIA" }
+}"#,
+    )
+    .unwrap();
+    let mut s = initialized(body, &[("gravity[2]", -9.81)]);
+    let h = 1e-3;
+    let reaction = vr(&s, "pivot.force[2]");
+    s.do_step(0.0, h).unwrap();
+    let region = Region::new(GLOBAL);
+    for k in 1..21 {
+        s.do_step(k as f64 * h, h).unwrap();
+        s.get_real(reaction).unwrap();
+    }
+    let stats = region.change();
+    assert_eq!(
+        stats.allocations + stats.reallocations,
+        0,
+        "allocations in 20 pinned Radau steps: {stats:?}"
+    );
 }
 
 /// Steps of the default body with damping, gravity, a tip load and `settings`.

@@ -124,6 +124,12 @@ fn element_coordinates(mesh: &Mesh, e: usize, coords: &mut [[f64; 3]; MAX_NODES]
 /// The consistent scalar mass matrix `Ms[i,j] = ∫ ρ N_i N_j dV` (kg), `N × N` for `N` nodes.
 /// The mass matrix of the body is `M = Ms ⊗ I3`. `Σ_ij Ms[i,j] = ρ V` (partition of unity).
 pub fn scalar_mass_matrix(mesh: &Mesh, density: f64) -> SymmetricCsr {
+    scalar_mass_matrix_of(mesh, &|_| density)
+}
+
+/// [`scalar_mass_matrix`] with the density (kg/m³) of each element, `density(e)` (material
+/// regions).
+pub fn scalar_mass_matrix_of(mesh: &Mesh, density: &dyn Fn(usize) -> f64) -> SymmetricCsr {
     let graph = NodeGraph::new(mesh);
     let reference = ReferenceElement::for_mass(mesh.kind());
     let n = mesh.kind().node_count();
@@ -133,6 +139,7 @@ pub fn scalar_mass_matrix(mesh: &Mesh, density: f64) -> SymmetricCsr {
     let mut positions = [0usize; MAX_NODES * MAX_NODES];
     let mut me = [[0.0; MAX_NODES]; MAX_NODES];
     for e in 0..mesh.element_count() {
+        let density = density(e);
         element_coordinates(mesh, e, &mut coords);
         for row in me.iter_mut().take(n) {
             row[..n].fill(0.0);
@@ -207,11 +214,19 @@ fn displacement_pattern(graph: &NodeGraph) -> SymmetricCsr {
 /// `K_ab[d][e] = ∫ λ ∂_d N_a ∂_e N_b + μ ∂_e N_a ∂_d N_b + μ δ_de ∇N_a·∇N_b dV`
 /// (the Hessian of the strain energy density `λ/2 (tr ε)² + μ ε:ε`), which is what is summed.
 pub fn stiffness_matrix(mesh: &Mesh, material: &IsotropicMaterial) -> SymmetricCsr {
+    stiffness_matrix_of(mesh, &|_| *material)
+}
+
+/// [`stiffness_matrix`] with the material of each element, `material(e)` (material regions:
+/// `λ`, `μ` per element; the assembled `K` stays symmetric positive semi-definite with the
+/// six rigid-body modes in its kernel).
+pub fn stiffness_matrix_of(
+    mesh: &Mesh,
+    material: &dyn Fn(usize) -> IsotropicMaterial,
+) -> SymmetricCsr {
     let graph = NodeGraph::new(mesh);
     let reference = ReferenceElement::new(mesh.kind());
     let n = mesh.kind().node_count();
-    let lambda = material.lame_lambda();
-    let mu = material.shear_modulus();
     let node_count = mesh.node_count();
     let SymmetricCsr {
         row_ptr,
@@ -226,6 +241,9 @@ pub fn stiffness_matrix(mesh: &Mesh, material: &IsotropicMaterial) -> SymmetricC
     // Upper-triangle blocks (b ≥ a) of the element matrix, block (a, b) row-major 3×3.
     let mut ke = [[[0.0f64; 9]; MAX_NODES]; MAX_NODES];
     for e in 0..mesh.element_count() {
+        let element_material = material(e);
+        let lambda = element_material.lame_lambda();
+        let mu = element_material.shear_modulus();
         element_coordinates(mesh, e, &mut coords);
         for row in ke.iter_mut().take(n) {
             for block in row.iter_mut().take(n) {
@@ -287,6 +305,11 @@ pub fn stiffness_matrix(mesh: &Mesh, material: &IsotropicMaterial) -> SymmetricC
 /// HRZ-lumped (diagonal-scaled) nodal masses (kg): `m_i = Ms[i,i] · m_e / Σ_j Ms_e[j,j]` summed
 /// over elements; all positive, summing to the total mass `ρV`.
 pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
+    lumped_masses_of(mesh, &|_| density)
+}
+
+/// [`lumped_masses`] with the density (kg/m³) of each element, `density(e)`.
+pub fn lumped_masses_of(mesh: &Mesh, density: &dyn Fn(usize) -> f64) -> Vec<f64> {
     let reference = ReferenceElement::for_mass(mesh.kind());
     let n = mesh.kind().node_count();
     let mut lumped = vec![0.0; mesh.node_count()];
@@ -294,6 +317,7 @@ pub fn lumped_masses(mesh: &Mesh, density: f64) -> Vec<f64> {
     let mut gradients = [[0.0; 3]; MAX_NODES];
     let mut diagonal = [0.0; MAX_NODES];
     for e in 0..mesh.element_count() {
+        let density = density(e);
         element_coordinates(mesh, e, &mut coords);
         diagonal[..n].fill(0.0);
         let mut element_mass = 0.0;

@@ -12,6 +12,9 @@ pub mod quadrature;
 pub mod sparse;
 pub mod stress;
 
-pub use assembly::{lumped_masses, scalar_mass_matrix, stiffness_matrix};
+pub use assembly::{
+    lumped_masses, lumped_masses_of, scalar_mass_matrix, scalar_mass_matrix_of, stiffness_matrix,
+    stiffness_matrix_of,
+};
 pub use material::IsotropicMaterial;
 pub use sparse::SymmetricCsr;

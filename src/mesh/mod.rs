@@ -228,6 +228,18 @@ impl Mesh {
         &self.connectivity[e * n..(e + 1) * n]
     }
 
+    /// The centroid of element `e`'s nodes (m): the mean of their reference positions.
+    pub fn element_centroid(&self, e: usize) -> [f64; 3] {
+        let nodes = self.element(e);
+        let mut c = [0.0; 3];
+        for &i in nodes {
+            for (cd, pd) in c.iter_mut().zip(&self.nodes[i]) {
+                *cd += pd;
+            }
+        }
+        c.map(|v| v / nodes.len() as f64)
+    }
+
     /// Smallest axis-aligned box holding all nodes: (min, max).
     pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
         let mut lo = [f64::INFINITY; 3];

@@ -20,6 +20,10 @@ pub struct BodyFile {
     pub description: String,
     pub mesh: MeshSpec,
     pub material: MaterialSpec,
+    /// Material regions: elements with their own Young's modulus (and density); the body's
+    /// `material` elsewhere.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub regions: Vec<RegionSpec>,
     #[serde(default)]
     pub damping: DampingSpec,
     /// Gravitational acceleration (m/s²), global frame.
@@ -90,6 +94,43 @@ pub struct MaterialSpec {
     pub youngs_modulus: f64,
     pub poisson_ratio: f64,
     pub density: f64,
+}
+
+/// A material region (body file: `{ "name": "stiff", "elements": { "box": { "min": [..],
+/// "max": [..] } }, "youngsModulus": 2.1e15, "density": 7850 }`): the selected elements get
+/// this Young's modulus (Pa) and, if given, density (kg/m³); Poisson's ratio stays the body's.
+/// The FMU's `material.*` parameters set the material outside every region; a region's values
+/// are fixed by the body file. Where regions overlap the later one wins.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub struct RegionSpec {
+    pub name: String,
+    pub elements: ElementSelector,
+    pub youngs_modulus: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+}
+
+/// A rule selecting elements of a mesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields)]
+pub enum ElementSelector {
+    /// Elements whose centroid (mean of the element's node positions) lies in the closed
+    /// axis-aligned box (m), with the node selectors' tolerance
+    /// ([`crate::mesh::selector::RELATIVE_TOLERANCE`] × bounding-box diagonal).
+    Box { min: [f64; 3], max: [f64; 3] },
+}
+
+impl ElementSelector {
+    /// Whether element `e`'s centroid is selected; `tolerance` in m.
+    fn contains(&self, mesh: &Mesh, e: usize, tolerance: f64) -> bool {
+        match self {
+            ElementSelector::Box { min, max } => {
+                let c = mesh.element_centroid(e);
+                (0..3).all(|d| c[d] >= min[d] - tolerance && c[d] <= max[d] + tolerance)
+            }
+        }
+    }
 }
 
 /// Rayleigh damping of the deformation, `f_d = hR (α M + β K) dū/dt`.
@@ -169,6 +210,10 @@ pub enum Integrator {
     GeneralizedAlpha,
     /// Explicit central difference with the lumped mass, the step limited by `2/ω_max`.
     CentralDifference,
+    /// Implicit Radau IIA (3 stages, order 5, L-stable): one real and one complex constant
+    /// factorization per step size (`solver::radau`); reduced-strain formulation only.
+    #[serde(rename = "radauIIA")]
+    RadauIIA,
 }
 
 impl SolverSpec {
@@ -250,6 +295,31 @@ impl BodyFile {
         BodyFile::from_json(DEFAULT_BODY_JSON).expect("the embedded default body is valid")
     }
 
+    /// The region of each element of `mesh` (index into `regions`; `None`: the body's material).
+    /// Error if a region selects no element, naming it.
+    pub fn element_regions(&self, mesh: &Mesh) -> Result<Vec<Option<usize>>> {
+        let (lo, hi) = mesh.bounding_box();
+        let diagonal = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum::<f64>().sqrt();
+        let tolerance = crate::mesh::selector::RELATIVE_TOLERANCE * diagonal;
+        let mut regions = vec![None; mesh.element_count()];
+        for (k, region) in self.regions.iter().enumerate() {
+            let mut any = false;
+            for (e, slot) in regions.iter_mut().enumerate() {
+                if region.elements.contains(mesh, e, tolerance) {
+                    *slot = Some(k);
+                    any = true;
+                }
+            }
+            if !any {
+                return Err(Error::new(format!(
+                    "body file: region '{}' selects no element (no element centroid in {:?})",
+                    region.name, region.elements
+                )));
+            }
+        }
+        Ok(regions)
+    }
+
     /// Canonical JSON text (used for the GUID).
     pub fn to_canonical_json(&self) -> String {
         serde_json::to_string(self).expect("a body file serializes")
@@ -294,6 +364,31 @@ impl BodyFile {
                     "body file: interface name '{}' is used twice",
                     i.name
                 )));
+            }
+        }
+        let mut region_names = std::collections::BTreeSet::new();
+        for r in &self.regions {
+            let fail = |what: &str| {
+                Err(Error::new(format!(
+                    "body file: region '{}': {what}",
+                    r.name
+                )))
+            };
+            if r.name.is_empty() || !region_names.insert(r.name.as_str()) {
+                return fail("region names must be non-empty and unique");
+            }
+            if !(r.youngs_modulus.is_finite() && r.youngs_modulus > 0.0) {
+                return fail(&format!(
+                    "youngsModulus = {} must be positive and finite",
+                    r.youngs_modulus
+                ));
+            }
+            if let Some(d) = r.density.filter(|d| !(d.is_finite() && *d > 0.0)) {
+                return fail(&format!("density = {d} must be positive and finite"));
+            }
+            let ElementSelector::Box { min, max } = &r.elements;
+            if (0..3).any(|d| !(min[d].is_finite() && max[d].is_finite() && min[d] <= max[d])) {
+                return fail("elements.box: min must not exceed max and all bounds must be finite");
             }
         }
         if self.model.frames < 1 {

@@ -385,6 +385,12 @@ impl StepWorkspace {
         &self.force_scratch
     }
 
+    /// The geometric stiffness (if any) and the force scratch, for another scheme's residual
+    /// ([`super::radau`]) that shares this workspace's stiffening and strain watch.
+    pub fn force_parts(&mut self) -> (Option<&SymmetricCsr>, &mut ForceScratch) {
+        (self.geometric_stiffness.as_ref(), &mut self.force_scratch)
+    }
+
     pub fn new(body: &Body, free: &FreeNodes) -> StepWorkspace {
         Self::with_anderson_depth(body, free, DEFAULT_ANDERSON_DEPTH)
     }
