@@ -2,6 +2,7 @@
 //! stiffness `K`, the co-moving frame, the local deformation `ū`, the internal force with the
 //! nonlinear term `f_nl`, Rayleigh damping of the deformation, and the node sets of interfaces.
 
+pub mod feature_indicators;
 pub mod frame;
 pub mod interface;
 pub mod patches;
@@ -67,6 +68,11 @@ pub struct Body {
     /// force is `Σ_p R_p K_p ū_p` (+ each patch's `f_nl`) instead of the body frame's `R K ū`;
     /// damping and stiffening stay in the body frame.
     pub patches: Option<Patches>,
+    /// Whether `options.nonlinear_forces` may be switched on between steps (`model.auto` with
+    /// `model.nonlinearForces` allowed): the iteration matrices then carry the Woodbury
+    /// correction of `f_nl` (computed once per step size) even while the term is off, so that
+    /// switching it on needs no new factorization.
+    pub nonlinear_forces_switchable: bool,
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -139,6 +145,7 @@ impl Body {
             options,
             full: None,
             patches: None,
+            nonlinear_forces_switchable: false,
         }
     }
 

@@ -213,6 +213,10 @@ pub struct ModelSpec {
     /// the whole body.
     #[serde(default = "ModelSpec::default_frames")]
     pub frames: u32,
+    /// `model.auto` (default true): the nonlinear force and the stiffening are upper bounds, each
+    /// switched on per step only when it changes the result beyond the solver tolerance.
+    #[serde(default = "ModelSpec::default_auto")]
+    pub auto: bool,
 }
 
 impl Default for ModelSpec {
@@ -220,6 +224,7 @@ impl Default for ModelSpec {
         ModelSpec {
             nonlinear_forces: false,
             frames: ModelSpec::default_frames(),
+            auto: ModelSpec::default_auto(),
         }
     }
 }
@@ -227,6 +232,9 @@ impl Default for ModelSpec {
 impl ModelSpec {
     fn default_frames() -> u32 {
         1
+    }
+    fn default_auto() -> bool {
+        true
     }
 }
 
