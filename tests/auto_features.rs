@@ -199,3 +199,60 @@ fn auto_decisions_are_part_of_the_fmu_state() {
     }
     assert_eq!(first, second);
 }
+
+#[test]
+fn b3_auto_with_stress_stiffening_matches_stress_forced() {
+    // `stress` stiffening's indicator (12 ε (L/t)², see feature_indicators) over the first 3 s.
+    let run = |auto: f64| {
+        let mut s = initialized(
+            example_body("hub_beam"),
+            &[("model.auto", auto), ("model.stiffening", 3.0)],
+        );
+        let drive = common::b3::HubDrive::new(&s);
+        let mut log = decisions(&mut s);
+        let y: Vec<f64> = (0..300)
+            .map(|k| {
+                let y = drive.step(&mut s, k as f64 * 1e-2, 1e-2).unwrap();
+                log.extend(decisions(&mut s));
+                y
+            })
+            .collect();
+        (y, log)
+    };
+    let (y_on, log_on) = run(0.0);
+    let (y_auto, log) = run(1.0);
+    let (y_off, _) = b3(&ALL_OFF);
+    for m in &log {
+        println!("{m}");
+    }
+    assert!(log_on.is_empty(), "forced: no decisions");
+    assert!(
+        log.iter().any(|m| m.contains("stiffening switched on")),
+        "{log:?}"
+    );
+    let d_auto = largest_difference(&y_auto, &y_on);
+    let d_off = largest_difference(&y_off[..300], &y_on);
+    println!("B3, stress: |auto − forced| = {d_auto:.3e} m, |off − forced| = {d_off:.3e} m");
+    let bound = 300.0 * 1e-10 * 10.0005;
+    assert!(d_auto < bound, "{d_auto:e} m, bound {bound:e} m");
+    assert!(d_off > 10.0 * bound, "{d_off:e} m");
+}
+
+#[test]
+fn model_auto_is_a_parameter_of_the_body_file_and_the_fmu() {
+    let mut s = Slave::from_body(flexbody::model::BodyFile::default_body()).unwrap();
+    let auto = vr(&s, "model.auto");
+    assert_eq!(auto, 9);
+    assert!(s.get_boolean(auto).unwrap(), "default true");
+    assert!(s
+        .model_description()
+        .contains(r#"name="model.auto" valueReference="9""#));
+    s.set_boolean(auto, false).unwrap();
+    assert!(!s.get_boolean(auto).unwrap());
+    let mut body = flexbody::model::BodyFile::default_body();
+    body.model.auto = false;
+    let text = body.to_canonical_json();
+    assert!(text.contains(r#""auto":false"#), "{text}");
+    let mut s = Slave::from_body(flexbody::model::BodyFile::from_json(&text).unwrap()).unwrap();
+    assert!(!s.get_boolean(auto).unwrap());
+}
