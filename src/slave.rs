@@ -45,6 +45,9 @@ const FORMULATION_FULL: i32 = 2;
 /// `model.stiffening` items.
 const STIFFENING_INERTIAL: i32 = 2;
 const STIFFENING_STRESS: i32 = 3;
+/// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
+/// finite number: the state's byte form holds finite numbers only).
+const NOT_QUIET: f64 = f64::MAX;
 /// `solver.integrator` items.
 const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
 const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
@@ -268,6 +271,9 @@ struct Dynamics {
     gravity: [f64; 3],
     /// The terms in force.
     features: Features,
+    /// Per term (f_nl, stiffening): since when its estimate has stayed below the switch-off
+    /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
+    quiet_since: [f64; 2],
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -772,6 +778,7 @@ impl Slave {
                 d.loads.clone_from(&s.loads);
                 d.gravity = s.gravity;
                 d.features = s.features;
+                d.quiet_since = s.quiet_since;
             }
             (d, s) => *d = s.clone(),
         }
@@ -1885,6 +1892,7 @@ impl Slave {
             loads: self.inputs.clone(),
             gravity: p.gravity,
             features,
+            quiet_since: [NOT_QUIET; 2],
         });
         self.outputs.valid = false;
         Ok(())
@@ -2104,7 +2112,9 @@ fn point_constraints(
 /// `model.auto`: decides from the state at the communication point which allowed terms are in
 /// force over the next communication step (held over its internal steps, like `K_G`), logs each
 /// change once under `logEvents` with the estimate and the threshold, and puts the terms into
-/// force. `target` is the iteration's absolute tolerance `solver.tolerance × size` (m). No
+/// force. A term goes on when `SAFETY × estimate > target`; it goes off when that has stayed
+/// below `HYSTERESIS × target` for one period `2π/ω₁` of the lowest mode (a vibrating body's
+/// indicators peak twice per period: the dwell keeps a term from switching with the vibration). `target` is the iteration's absolute tolerance `solver.tolerance × size` (m). No
 /// allocation unless a decision changes.
 fn choose_features(
     model: &mut Model,
@@ -2115,15 +2125,31 @@ fn choose_features(
     if let Some(indicators) = model.indicators.as_mut() {
         let s = &dynamics.state;
         let e = indicators.estimate(&model.body, &s.position, &s.velocity, &s.acceleration);
+        let dwell = indicators
+            .first_frequency()
+            .map_or(0.0, |w| 2.0 * std::f64::consts::PI / w);
         let mut f = dynamics.features;
-        let mut decide = |active: &mut bool, allowed: bool, estimate: Option<f64>, name: &str| {
+        let mut decide = |active: &mut bool,
+                          quiet_since: &mut f64,
+                          allowed: bool,
+                          estimate: Option<f64>,
+                          name: &str| {
             let Some(e) = estimate.filter(|_| allowed) else {
                 *active = allowed;
+                *quiet_since = NOT_QUIET;
                 return;
             };
             let scaled = feature_indicators::SAFETY * e;
             let next = if *active {
-                scaled >= feature_indicators::HYSTERESIS * target
+                if scaled >= feature_indicators::HYSTERESIS * target {
+                    *quiet_since = NOT_QUIET;
+                    true
+                } else {
+                    if *quiet_since == NOT_QUIET {
+                        *quiet_since = s.time;
+                    }
+                    s.time - *quiet_since < dwell
+                }
             } else {
                 scaled > target
             };
@@ -2139,24 +2165,28 @@ fn choose_features(
                         )
                     } else {
                         format!(
-                            "model.auto: at t = {} {name} switched off: estimated effect {e:.3e} m, × {} = {scaled:.3e} m < {} × solver.tolerance × size = {:.3e} m",
+                            "model.auto: at t = {} {name} switched off: estimated effect {e:.3e} m, × {} = {scaled:.3e} m < {} × solver.tolerance × size = {:.3e} m since t = {} (at least one period 2π/ω₁ = {dwell:.3e} s)",
                             s.time,
                             feature_indicators::SAFETY,
                             feature_indicators::HYSTERESIS,
-                            feature_indicators::HYSTERESIS * target
+                            feature_indicators::HYSTERESIS * target,
+                            *quiet_since
                         )
                     },
                 });
             }
         };
+        let [quiet_nl, quiet_stiffening] = &mut dynamics.quiet_since;
         decide(
             &mut f.nonlinear_forces,
+            quiet_nl,
             model.allowed.nonlinear_forces,
             e.nonlinear_forces,
             "the nonlinear force f_nl",
         );
         decide(
             &mut f.stiffening,
+            quiet_stiffening,
             model.allowed.stiffening,
             e.stiffening,
             "geometric stiffening",

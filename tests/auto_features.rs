@@ -106,6 +106,10 @@ fn b1_full_load_auto_keeps_f_nl_and_matches_all_on() {
         log.iter().any(|m| m.contains("f_nl switched on")),
         "{log:?}"
     );
+    // Inertial stiffening's estimate (1.2e-11 m at its peaks, the vibration's angular
+    // acceleration) oscillates with the vibration across both thresholds; the switch-off dwell of
+    // one period 2π/ω₁ keeps it from switching with it (without the dwell: on/off 4 times).
+    assert!(!log.iter().any(|m| m.contains("switched off")), "{log:?}");
     let bound = 100.0 * 1e-10 * B1_SIZE;
     assert!(
         d_auto < bound,

@@ -13,7 +13,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening); since when their indicators are quiet [2] f64 (f64::MAX: not) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -162,6 +162,7 @@ impl SlaveState {
                 d.loads.iter().for_each(|l| w.f64s(l));
                 w.f64s(&d.gravity);
                 w.u8(u8::from(d.features.nonlinear_forces) | u8::from(d.features.stiffening) << 1);
+                w.f64s(&d.quiet_since);
             }
         }
     }
@@ -283,6 +284,11 @@ impl Slave {
                         )))
                     }
                 };
+                let mut quiet_since = [0.0; 2];
+                r.f64s(
+                    &mut quiet_since,
+                    "the times since the terms' indicators are quiet",
+                )?;
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -296,6 +302,7 @@ impl Slave {
                     loads,
                     gravity,
                     features,
+                    quiet_since,
                 })
             }
             b => {
