@@ -1617,7 +1617,7 @@ impl Slave {
             self.events.push(LogEvent {
                 category: "logEvents",
                 message: format!(
-                    "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds solver.tolerance × size = {:.3e} m, off below {} of that",
+                    "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds solver.tolerance × size = {:.3e} m, off when it stayed below {} of that for one period 2π/ω₁",
                     verdict(
                         allowed.nonlinear_forces,
                         ind.estimates_nonlinear_forces(),
