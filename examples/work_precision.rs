@@ -15,6 +15,8 @@
 //!   tip deflection in the hub frame sampled every 20 ms, h ∈ {2e-2, 1e-2, 5e-3} s against `full`
 //!   at h = 2.5e-3 s (one run each).
 //!
+//! `--auto-only`: only the `model.auto` table (below).
+//!
 //! `--quick` (for checking the task): B1 at two step sizes against h = 1e-4 s, B3 over 3 s
 //! against `full` at 5e-3 s.
 //!
@@ -179,62 +181,65 @@ fn main() {
     let mut csv =
         String::from("problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error\n");
     let repeats = if quick { 1 } else { 3 };
+    // `--auto-only`: only the model.auto table.
+    let auto_only = std::env::args().any(|a| a == "--auto-only");
 
-    // ---- B1 -------------------------------------------------------------------------------
-    let end = 0.1;
-    let body = BodyFile::default_body();
-    let h_ref = if quick { 1e-4 } else { 2.5e-5 };
-    let (reference, _) = b1(&body, h_ref, MODELS[0].1, end);
-    let peak = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    if let Some(path) = &csv_path {
-        let mut text = String::from("t,tip_y\n");
-        for (k, y) in reference.iter().enumerate() {
-            writeln!(text, "{},{y:.12e}", k as f64 * 2e-3).unwrap();
+    if !auto_only {
+        // ---- B1 -------------------------------------------------------------------------------
+        let end = 0.1;
+        let body = BodyFile::default_body();
+        let h_ref = if quick { 1e-4 } else { 2.5e-5 };
+        let (reference, _) = b1(&body, h_ref, MODELS[0].1, end);
+        let peak = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        if let Some(path) = &csv_path {
+            let mut text = String::from("t,tip_y\n");
+            for (k, y) in reference.iter().enumerate() {
+                writeln!(text, "{},{y:.12e}", k as f64 * 2e-3).unwrap();
+            }
+            let stem = path.with_extension("");
+            std::fs::write(format!("{}_b1_reference.csv", stem.display()), text).unwrap();
         }
-        let stem = path.with_extension("");
-        std::fs::write(format!("{}_b1_reference.csv", stem.display()), text).unwrap();
-    }
-    println!(
+        println!(
         "B1 dynamic: {} ({} s, 10 N step load, ρ∞ = {}, communication step 2 ms); reference `reducedStrain` at h = {h_ref:e} s, peak |tip y| = {peak:.4e} m\n",
         body.name,
         end,
         body.solver.rho_inf,
     );
-    println!("| model | h (s) | steps | wall (ms, median of {repeats}; `full`: 1 run) | steps/s | max tip error (m) | error / peak |");
-    println!("|---|---|---|---|---|---|---|");
-    let steps_b1: &[f64] = if quick {
-        &[2e-3, 5e-4]
-    } else {
-        &[2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4]
-    };
-    for (label, settings) in MODELS {
-        for &h in steps_b1 {
-            let mut walls = Vec::new();
-            let mut error = 0.0;
-            let runs = if label == "full" { 1 } else { repeats };
-            for _ in 0..runs {
-                let (y, wall) = b1(&body, h, settings, end);
-                error = max_error(&y, &reference);
-                walls.push(wall);
+        println!("| model | h (s) | steps | wall (ms, median of {repeats}; `full`: 1 run) | steps/s | max tip error (m) | error / peak |");
+        println!("|---|---|---|---|---|---|---|");
+        let steps_b1: &[f64] = if quick {
+            &[2e-3, 5e-4]
+        } else {
+            &[2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4]
+        };
+        for (label, settings) in MODELS {
+            for &h in steps_b1 {
+                let mut walls = Vec::new();
+                let mut error = 0.0;
+                let runs = if label == "full" { 1 } else { repeats };
+                for _ in 0..runs {
+                    let (y, wall) = b1(&body, h, settings, end);
+                    error = max_error(&y, &reference);
+                    walls.push(wall);
+                }
+                let wall = median(walls);
+                let steps = (end / h).round() as usize;
+                println!(
+                    "| {label} | {h:e} | {steps} | {:.1} | {:.0} | {error:.3e} | {:.2e} |",
+                    1e3 * wall,
+                    steps as f64 / wall,
+                    error / peak
+                );
+                writeln!(
+                    csv,
+                    "B1,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
+                    steps as f64 / wall,
+                    error / peak
+                )
+                .unwrap();
             }
-            let wall = median(walls);
-            let steps = (end / h).round() as usize;
-            println!(
-                "| {label} | {h:e} | {steps} | {:.1} | {:.0} | {error:.3e} | {:.2e} |",
-                1e3 * wall,
-                steps as f64 / wall,
-                error / peak
-            );
-            writeln!(
-                csv,
-                "B1,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
-                steps as f64 / wall,
-                error / peak
-            )
-            .unwrap();
         }
     }
-
     // ---- B3 -------------------------------------------------------------------------------
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -243,41 +248,45 @@ fn main() {
     .unwrap();
     let body = BodyFile::from_json(&text).unwrap();
     let (end, h_ref) = if quick { (3.0, 5e-3) } else { (20.0, 2.5e-3) };
-    let started = Instant::now();
-    let (reference, _) = b3(&body, h_ref, MODELS[4].1, end).unwrap();
-    let peak = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    println!(
+    if !auto_only {
+        let started = Instant::now();
+        let (reference, _) = b3(&body, h_ref, MODELS[4].1, end).unwrap();
+        let peak = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        println!(
         "\nB3 spin-up: {} s simulated, tip deflection in the hub frame every 20 ms; reference `full` at h = {h_ref:e} s ({:.0} s wall), peak |y| = {peak:.4} m\n",
         end,
         started.elapsed().as_secs_f64()
     );
-    println!("| model | h (s) | steps | wall (s) | steps/s | max tip error (m) | error / peak |");
-    println!("|---|---|---|---|---|---|---|");
-    let steps_b3: &[f64] = if quick {
-        &[2e-2, 1e-2]
-    } else {
-        &[2e-2, 1e-2, 5e-3]
-    };
-    for (label, settings) in MODELS {
-        for &h in steps_b3 {
-            let steps = (end / h).round() as usize;
-            match b3(&body, h, settings, end) {
-                Ok((y, wall)) => {
-                    let error = max_error(&y, &reference);
-                    println!(
+        println!(
+            "| model | h (s) | steps | wall (s) | steps/s | max tip error (m) | error / peak |"
+        );
+        println!("|---|---|---|---|---|---|---|");
+        let steps_b3: &[f64] = if quick {
+            &[2e-2, 1e-2]
+        } else {
+            &[2e-2, 1e-2, 5e-3]
+        };
+        for (label, settings) in MODELS {
+            for &h in steps_b3 {
+                let steps = (end / h).round() as usize;
+                match b3(&body, h, settings, end) {
+                    Ok((y, wall)) => {
+                        let error = max_error(&y, &reference);
+                        println!(
                         "| {label} | {h:e} | {steps} | {wall:.2} | {:.0} | {error:.3e} | {:.2e} |",
                         steps as f64 / wall,
                         error / peak
                     );
-                    writeln!(
-                        csv,
-                        "B3,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
-                        steps as f64 / wall,
-                        error / peak
-                    )
-                    .unwrap();
+                        writeln!(
+                            csv,
+                            "B3,\"{label}\",{h:e},{steps},{wall:.6e},{:.6e},{error:.6e},{:.6e}",
+                            steps as f64 / wall,
+                            error / peak
+                        )
+                        .unwrap();
+                    }
+                    Err(e) => println!("| {label} | {h:e} | {steps} | not run: {e} | | | |"),
                 }
-                Err(e) => println!("| {label} | {h:e} | {steps} | not run: {e} | | | |"),
             }
         }
     }
