@@ -95,6 +95,7 @@ fn main() {
                 vec![
                     ("model.nonlinearForces", f_nl),
                     ("model.stiffening", k as i32 + 1),
+                    ("model.auto", 0),
                 ],
             ));
         }
@@ -111,11 +112,27 @@ fn main() {
             ));
         }
     }
+    // model.auto with both terms allowed (issue 8): switched on when their indicators say so.
+    cases.push((
+        "reducedStrain, auto (f_nl, inertial stiffening allowed)".into(),
+        h,
+        vec![
+            ("model.nonlinearForces", 1),
+            ("model.stiffening", 2),
+            ("model.auto", 1),
+        ],
+    ));
     // The same with the plain fixed-point iteration (no Anderson acceleration).
     for (label, settings) in [
-        ("f_nl off", vec![]),
-        ("f_nl on", vec![("model.nonlinearForces", 1)]),
-        ("stiffening stress", vec![("model.stiffening", 3)]),
+        ("f_nl off", vec![("model.auto", 0)]),
+        (
+            "f_nl on",
+            vec![("model.nonlinearForces", 1), ("model.auto", 0)],
+        ),
+        (
+            "stiffening stress",
+            vec![("model.stiffening", 3), ("model.auto", 0)],
+        ),
         (
             "40 frames, f_nl on",
             vec![("model.nonlinearForces", 1), ("model.frames", 40)],

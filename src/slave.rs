@@ -2,6 +2,7 @@
 //! save and restore. Knows nothing of C pointers: the FMI glue in `fmi2` calls it after checking
 //! arguments and the calling sequence.
 
+use crate::body::feature_indicators::{self, FeatureIndicators};
 use crate::body::frame::{nearest_rotation, node};
 use crate::body::interface::{DrivingFrame, InterfaceMotion};
 use crate::body::stiffening::Stiffening;
@@ -46,6 +47,9 @@ const FORMULATION_FULL: i32 = 2;
 const STIFFENING_NONE: i32 = 1;
 const STIFFENING_INERTIAL: i32 = 2;
 const STIFFENING_STRESS: i32 = 3;
+/// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
+/// finite number: the state's byte form holds finite numbers only).
+const NOT_QUIET: f64 = f64::MAX;
 /// `solver.integrator` items.
 const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
 const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
@@ -96,6 +100,9 @@ pub struct Parameters {
     pub tolerance: f64,
     pub max_iterations: i32,
     pub nonlinear_forces: bool,
+    /// `model.auto`: with it `nonlinear_forces` and `stiffening` are what is allowed and the
+    /// slave switches each on per step when its indicator says it matters (see [`Features`]).
+    pub auto: bool,
     /// `model.formulation`: 1 reducedStrain, 2 full.
     pub formulation: i32,
     /// `model.stiffening`: 1 none, 2 inertial, 3 stress.
@@ -134,6 +141,7 @@ impl Parameters {
             tolerance: b.solver.tolerance,
             max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
             nonlinear_forces: b.model.nonlinear_forces,
+            auto: b.model.auto,
             formulation: 1,
             stiffening: 1,
             frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
@@ -159,7 +167,7 @@ impl Parameters {
                 self.damping_beta.to_bits(),
                 self.rho_inf.to_bits(),
             ],
-            self.nonlinear_forces,
+            [self.nonlinear_forces, self.auto],
             [
                 self.formulation * 16 + self.stiffening,
                 self.frames,
@@ -210,10 +218,19 @@ struct Interface {
     first_constraint: usize,
 }
 
-/// The assembled model for one set of parameters.
 /// What the assembled model depends on (see [`Parameters::model_key`]).
-type ModelKey = (IsotropicMaterial, [u64; 3], bool, [i32; 5]);
+type ModelKey = (IsotropicMaterial, [u64; 3], [bool; 2], [i32; 5]);
 
+/// The terms in force during a step: with `model.auto` chosen per communication step by
+/// [`FeatureIndicators`] among the allowed ones, otherwise the forced switches. Part of the
+/// state (saved and restored with it), since the choice has hysteresis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Features {
+    pub nonlinear_forces: bool,
+    pub stiffening: bool,
+}
+
+/// The assembled model for one set of parameters.
 struct Model {
     key: ModelKey,
     body: Body,
@@ -234,6 +251,30 @@ struct Model {
     radau: Option<RadauModel>,
     /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
     strain_monitor: Option<(StrainMonitor, bool)>,
+    /// `model.auto`'s indicators (one co-moving frame, reduced strain, some term allowed).
+    indicators: Option<FeatureIndicators>,
+    /// The allowed terms: upper bounds of [`Features`].
+    allowed: Features,
+    /// `K_G` while stiffening is switched off (it moves to `workspace.geometric_stiffness` and
+    /// back: no allocation).
+    parked_geometric_stiffness: Option<crate::fem::SymmetricCsr>,
+}
+
+impl Model {
+    /// Puts `features` into force: the body's `f_nl` switch and where `K_G` lives. The iteration
+    /// matrices are not touched: they carry the Woodbury correction of `f_nl` whenever it is
+    /// allowed (unused while it is off), and stiffening is on the right-hand side, absorbed by
+    /// the fixed-point/Anderson iteration; so a switch never refactorises.
+    fn apply_features(&mut self, features: Features) {
+        self.body.options.nonlinear_forces = features.nonlinear_forces;
+        let active = self.workspace.geometric_stiffness.is_some();
+        if features.stiffening != active {
+            std::mem::swap(
+                &mut self.workspace.geometric_stiffness,
+                &mut self.parked_geometric_stiffness,
+            );
+        }
+    }
 }
 
 /// Radau IIA's part of the model.
@@ -250,6 +291,11 @@ struct Dynamics {
     /// Inputs per interface that `state`'s accelerations belong to.
     loads: Vec<Inputs>,
     gravity: [f64; 3],
+    /// The terms in force.
+    features: Features,
+    /// Per term (f_nl, stiffening): since when its estimate has stayed below the switch-off
+    /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
+    quiet_since: [f64; 2],
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -768,8 +814,13 @@ impl Slave {
                 d.state.copy_from(&s.state);
                 d.loads.clone_from(&s.loads);
                 d.gravity = s.gravity;
+                d.features = s.features;
+                d.quiet_since = s.quiet_since;
             }
             (d, s) => *d = s.clone(),
+        }
+        if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
+            model.apply_features(d.features);
         }
         self.outputs.valid = false;
         Ok(())
@@ -1024,6 +1075,13 @@ impl Slave {
                 self.parameters.nonlinear_forces = value;
                 Ok(())
             }
+            Target::Fixed {
+                key: FixedKey::Auto,
+                ..
+            } => {
+                self.parameters.auto = value;
+                Ok(())
+            }
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
         }
     }
@@ -1276,6 +1334,12 @@ impl Slave {
         self.matrix_index(h)?;
         let model = self.model.as_mut().expect("matrix_index built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
+        choose_features(
+            model,
+            dynamics,
+            self.parameters.tolerance * self.size,
+            &mut self.events,
+        );
         if let (Some(stiffening), Some(k_g)) = (
             model.stiffening.as_mut(),
             model.workspace.geometric_stiffness.as_mut(),
@@ -1752,6 +1816,56 @@ impl Slave {
         if stiffening.is_some() {
             workspace.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
         }
+        // model.auto: indicators for the allowed terms of the one-frame reduced-strain body
+        // (patches and the full formulation have no switchable terms: forced as given).
+        let allowed = Features {
+            nonlinear_forces: p.nonlinear_forces,
+            stiffening: stiffening.is_some(),
+        };
+        // The reduced body is forced as given too (its indicators would need the expanded mesh).
+        let single = p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
+        let indicators = (p.auto && single && (allowed.nonlinear_forces || allowed.stiffening))
+            .then(|| {
+                FeatureIndicators::new(
+                    &self.mesh,
+                    &body,
+                    &free.nodes,
+                    &free.stiffness,
+                    &free.mass,
+                    !free.clamped.is_empty(),
+                    stiffening.as_ref(),
+                )
+            });
+        let mut body = body;
+        body.nonlinear_forces_switchable = indicators.is_some() && allowed.nonlinear_forces;
+        if let Some(ind) = &indicators {
+            let verdict = |allowed: bool, estimated: bool, why: &str| {
+                if !allowed {
+                    "not allowed (off)".to_string()
+                } else if estimated {
+                    "allowed, switched per communication step by its indicator".to_string()
+                } else {
+                    format!("allowed, always on ({why})")
+                }
+            };
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds solver.tolerance × size = {:.3e} m, off when it stayed below {} of that for one period 2π/ω₁",
+                    verdict(
+                        allowed.nonlinear_forces,
+                        ind.estimates_nonlinear_forces(),
+                        "no estimate for a body without fixed supports or motion interfaces: its spurious moment accumulates"
+                    ),
+                    verdict(allowed.stiffening, ind.estimates_stiffening(), "no estimate"),
+                    ind.first_frequency()
+                        .map_or("not computed".to_string(), |w| format!("{w:.4e} rad/s")),
+                    feature_indicators::SAFETY,
+                    p.tolerance * self.size,
+                    feature_indicators::HYSTERESIS
+                ),
+            });
+        }
         self.events.push(LogEvent {
             category: "logEvents",
             message: format!(
@@ -1823,6 +1937,9 @@ impl Slave {
             free,
             workspace,
             stiffening,
+            indicators,
+            allowed,
+            parked_geometric_stiffness: None,
         });
         self.dynamics = None;
         // The backups have the old model's size (a changed model.modes changes it).
@@ -1964,6 +2081,17 @@ impl Slave {
             )));
         }
         let model = self.model.as_mut().unwrap();
+        // model.auto starts with the terms that have an estimate off (the body is placed
+        // rigidly: ū = 0, where both vanish); without it the switches are forced.
+        let features = match &model.indicators {
+            Some(ind) => Features {
+                nonlinear_forces: model.allowed.nonlinear_forces
+                    && !ind.estimates_nonlinear_forces(),
+                stiffening: model.allowed.stiffening && !ind.estimates_stiffening(),
+            },
+            None => model.allowed,
+        };
+        model.apply_features(features);
         let body = &model.body;
         let n = body.node_count();
         let mut state = DynamicState {
@@ -2059,6 +2187,8 @@ impl Slave {
             state,
             loads: self.inputs.clone(),
             gravity: p.gravity,
+            features,
+            quiet_since: [NOT_QUIET; 2],
         });
         self.outputs.valid = false;
         Ok(())
@@ -2275,6 +2405,93 @@ fn point_constraints(
     }
 }
 
+/// `model.auto`: decides from the state at the communication point which allowed terms are in
+/// force over the next communication step (held over its internal steps, like `K_G`), logs each
+/// change once under `logEvents` with the estimate and the threshold, and puts the terms into
+/// force. A term goes on when `SAFETY × estimate > target`; it goes off when that has stayed
+/// below `HYSTERESIS × target` for one period `2π/ω₁` of the lowest mode (a vibrating body's
+/// indicators peak twice per period: the dwell keeps a term from switching with the vibration). `target` is the iteration's absolute tolerance `solver.tolerance × size` (m). No
+/// allocation unless a decision changes.
+fn choose_features(
+    model: &mut Model,
+    dynamics: &mut Dynamics,
+    target: f64,
+    events: &mut Vec<LogEvent>,
+) {
+    if let Some(indicators) = model.indicators.as_mut() {
+        let s = &dynamics.state;
+        let e = indicators.estimate(&model.body, &s.position, &s.velocity, &s.acceleration);
+        let dwell = indicators
+            .first_frequency()
+            .map_or(0.0, |w| 2.0 * std::f64::consts::PI / w);
+        let mut f = dynamics.features;
+        let mut decide = |active: &mut bool,
+                          quiet_since: &mut f64,
+                          allowed: bool,
+                          estimate: Option<f64>,
+                          name: &str| {
+            let Some(e) = estimate.filter(|_| allowed) else {
+                *active = allowed;
+                *quiet_since = NOT_QUIET;
+                return;
+            };
+            let scaled = feature_indicators::SAFETY * e;
+            let next = if *active {
+                if scaled >= feature_indicators::HYSTERESIS * target {
+                    *quiet_since = NOT_QUIET;
+                    true
+                } else {
+                    if *quiet_since == NOT_QUIET {
+                        *quiet_since = s.time;
+                    }
+                    s.time - *quiet_since < dwell
+                }
+            } else {
+                scaled > target
+            };
+            if next != *active {
+                *active = next;
+                events.push(LogEvent {
+                    category: "logEvents",
+                    message: if next {
+                        format!(
+                            "model.auto: at t = {} {name} switched on: estimated effect {e:.3e} m, × {} = {scaled:.3e} m > solver.tolerance × size = {target:.3e} m",
+                            s.time,
+                            feature_indicators::SAFETY
+                        )
+                    } else {
+                        format!(
+                            "model.auto: at t = {} {name} switched off: estimated effect {e:.3e} m, × {} = {scaled:.3e} m < {} × solver.tolerance × size = {:.3e} m since t = {} (at least one period 2π/ω₁ = {dwell:.3e} s)",
+                            s.time,
+                            feature_indicators::SAFETY,
+                            feature_indicators::HYSTERESIS,
+                            feature_indicators::HYSTERESIS * target,
+                            *quiet_since
+                        )
+                    },
+                });
+            }
+        };
+        let [quiet_nl, quiet_stiffening] = &mut dynamics.quiet_since;
+        decide(
+            &mut f.nonlinear_forces,
+            quiet_nl,
+            model.allowed.nonlinear_forces,
+            e.nonlinear_forces,
+            "the nonlinear force f_nl",
+        );
+        decide(
+            &mut f.stiffening,
+            quiet_stiffening,
+            model.allowed.stiffening,
+            e.stiffening,
+            "geometric stiffening",
+        );
+        dynamics.features = f;
+    }
+    model.apply_features(dynamics.features);
+}
+
 /// Clamps the nodes of every motion interface to its driving frame `tau` seconds into the step.
 fn prescribe_motion(
     body: &Body,
@@ -2470,6 +2687,7 @@ fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
 fn read_boolean(p: &Parameters, key: FixedKey) -> Option<bool> {
     match key {
         FixedKey::NonlinearForces => Some(p.nonlinear_forces),
+        FixedKey::Auto => Some(p.auto),
         _ => None,
     }
 }

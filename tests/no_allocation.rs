@@ -26,6 +26,8 @@ fn do_step_does_not_allocate_after_the_first_step() {
         ("model.nonlinearForces", 1.0),
         ("model.frames", 5.0),
     ]);
+    // model.auto (the default) with both terms allowed: the indicators run every step.
+    steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.stiffening", 2.0)]);
     pinned_radau_steps_do_not_allocate();
 }
 
@@ -83,6 +85,10 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
     // two internal steps (another factorization allowed).
     s.do_step(0.0, h).unwrap();
     s.do_step(h, 2.0 * h).unwrap();
+    s.drain_events().for_each(drop);
+    // model.auto's decisions are log messages (formatted: one string each, plus its growth);
+    // they happen when a term is switched, not every step.
+    let mut decisions = 0;
     let region = Region::new(GLOBAL);
     let mut t = 3.0 * h;
     for k in 0..20 {
@@ -98,11 +104,14 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
         for &vr in &names {
             s.get_real(vr).unwrap();
         }
+        decisions += s
+            .drain_events()
+            .filter(|e| e.message.starts_with("model.auto: at t"))
+            .count();
     }
     let stats = region.change();
-    assert_eq!(
-        stats.allocations + stats.reallocations,
-        0,
-        "allocations in 20 steps with {settings:?}: {stats:?}"
+    assert!(
+        stats.allocations + stats.reallocations <= 2 * decisions,
+        "allocations in 20 steps with {settings:?}: {stats:?}, {decisions} decisions logged"
     );
 }

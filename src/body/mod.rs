@@ -2,6 +2,7 @@
 //! stiffness `K`, the co-moving frame, the local deformation `ū`, the internal force with the
 //! nonlinear term `f_nl`, Rayleigh damping of the deformation, and the node sets of interfaces.
 
+pub mod feature_indicators;
 pub mod frame;
 pub mod interface;
 pub mod patches;
@@ -73,6 +74,11 @@ pub struct Body {
     /// coordinates `q_k` of the basis fields, the matrices are the projected ones and this holds
     /// the basis to expand `q` to the mesh nodes.
     pub reduction: Option<Box<Reduction>>,
+    /// Whether `options.nonlinear_forces` may be switched on between steps (`model.auto` with
+    /// `model.nonlinearForces` allowed): the iteration matrices then carry the Woodbury
+    /// correction of `f_nl` (computed once per step size) even while the term is off, so that
+    /// switching it on needs no new factorization.
+    pub nonlinear_forces_switchable: bool,
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -146,6 +152,7 @@ impl Body {
             full: None,
             patches: None,
             reduction: None,
+            nonlinear_forces_switchable: false,
         }
     }
 
@@ -170,6 +177,7 @@ impl Body {
             full: None,
             patches: None,
             reduction: Some(Box::new(reduction)),
+            nonlinear_forces_switchable: false,
         }
     }
 

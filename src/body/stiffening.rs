@@ -33,6 +33,46 @@ pub enum Stiffening {
     },
 }
 
+/// The 12 coefficients of the co-moving frame's rigid acceleration field in body axes at the
+/// state `(x, v, a)` (flat 3N): `c̈` (m/s²), `α` (rad/s², least squares of the acceleration
+/// field about `c`, centripetal part removed), `ω_a ω_b` (a ≤ b: xx, yy, zz, xy, xz, yz; 1/s²).
+/// `inertial` stiffening's `K_G = Σ_k c_k K_G,k`. O(N), no allocation.
+pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f64; 12] {
+    let fw = &body.frame_weights;
+    let frame = fw.best_fit(x);
+    let rt = frame.rotation.transpose();
+    let h_inv = fw
+        .rotation_sensitivity(&frame, x)
+        .try_inverse()
+        .unwrap_or_else(Matrix3::zeros);
+    let omega = fw.angular_velocity(&frame, &h_inv, v);
+    let c_ddot = rt * fw.centroid(a);
+    let mut j = Matrix3::zeros();
+    let mut b = Vector3::zeros();
+    for ((&n, &w), xb) in fw.nodes.iter().zip(&fw.weights).zip(&fw.reference_offsets) {
+        let r = rt * (node(x, n) - frame.origin);
+        let ai = rt * node(a, n) - c_ddot - omega.cross(&omega.cross(xb));
+        j += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
+        b += w * r.cross(&ai);
+    }
+    let alpha = j.try_inverse().unwrap_or_else(Matrix3::zeros) * b;
+    let w = omega;
+    [
+        c_ddot.x,
+        c_ddot.y,
+        c_ddot.z,
+        alpha.x,
+        alpha.y,
+        alpha.z,
+        w.x * w.x,
+        w.y * w.y,
+        w.z * w.z,
+        w.x * w.y,
+        w.x * w.z,
+        w.y * w.z,
+    ]
+}
+
 /// The unit rigid acceleration field `k` (0..12) at the reference offset `xb`.
 fn unit_field(k: usize, xb: &Vector3<f64>) -> Vector3<f64> {
     let e = |j: usize| Vector3::ith(j, 1.0);
@@ -104,6 +144,14 @@ impl Stiffening {
         }
     }
 
+    /// The 12 unit load cases' geometric stiffnesses (`inertial` only).
+    pub fn unit_cases(&self) -> Option<&[SymmetricCsr]> {
+        match self {
+            Stiffening::Inertial { unit_cases } => Some(unit_cases),
+            Stiffening::Stress { .. } => None,
+        }
+    }
+
     /// A matrix with the pattern of `K_G`.
     pub fn pattern(mesh: &Mesh) -> SymmetricCsr {
         stiffness_pattern(mesh)
@@ -121,43 +169,9 @@ impl Stiffening {
         a: &[f64],
         k_g: &mut SymmetricCsr,
     ) {
-        let fw = &body.frame_weights;
-        let frame = fw.best_fit(x);
-        let rt = frame.rotation.transpose();
         match self {
             Stiffening::Inertial { unit_cases } => {
-                // The frame's rigid acceleration field in body axes: c̈, ω (from H), α (least
-                // squares of the acceleration field about c, centripetal part removed).
-                let h_inv = fw
-                    .rotation_sensitivity(&frame, x)
-                    .try_inverse()
-                    .unwrap_or_else(Matrix3::zeros);
-                let omega = fw.angular_velocity(&frame, &h_inv, v);
-                let c_ddot = rt * fw.centroid(a);
-                let mut j = Matrix3::zeros();
-                let mut b = Vector3::zeros();
-                for ((&n, &w), xb) in fw.nodes.iter().zip(&fw.weights).zip(&fw.reference_offsets) {
-                    let r = rt * (node(x, n) - frame.origin);
-                    let ai = rt * node(a, n) - c_ddot - omega.cross(&omega.cross(xb));
-                    j += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
-                    b += w * r.cross(&ai);
-                }
-                let alpha = j.try_inverse().unwrap_or_else(Matrix3::zeros) * b;
-                let w = omega;
-                let c = [
-                    c_ddot.x,
-                    c_ddot.y,
-                    c_ddot.z,
-                    alpha.x,
-                    alpha.y,
-                    alpha.z,
-                    w.x * w.x,
-                    w.y * w.y,
-                    w.z * w.z,
-                    w.x * w.y,
-                    w.x * w.z,
-                    w.y * w.z,
-                ];
+                let c = inertial_coefficients(body, x, v, a);
                 let terms: [(f64, &SymmetricCsr); 12] =
                     std::array::from_fn(|k| (c[k], &unit_cases[k]));
                 weighted_sum_into(k_g, &terms);
@@ -166,6 +180,9 @@ impl Stiffening {
                 stresses,
                 local_deformation,
             } => {
+                let fw = &body.frame_weights;
+                let frame = fw.best_fit(x);
+                let rt = frame.rotation.transpose();
                 for i in 0..body.node_count() {
                     let u = rt * (node(x, i) - frame.origin) - fw.reference_offsets[i];
                     set_node(local_deformation, i, &u);

@@ -263,6 +263,10 @@ pub struct ModelSpec {
     /// constraint and attachment modes (component mode synthesis in absolute coordinates).
     #[serde(default)]
     pub modes: u32,
+    /// `model.auto` (default true): the nonlinear force and the stiffening are upper bounds, each
+    /// switched on per step only when it changes the result beyond the solver tolerance.
+    #[serde(default = "ModelSpec::default_auto")]
+    pub auto: bool,
 }
 
 impl Default for ModelSpec {
@@ -271,6 +275,7 @@ impl Default for ModelSpec {
             nonlinear_forces: false,
             frames: ModelSpec::default_frames(),
             modes: 0,
+            auto: ModelSpec::default_auto(),
         }
     }
 }
@@ -278,6 +283,9 @@ impl Default for ModelSpec {
 impl ModelSpec {
     fn default_frames() -> u32 {
         1
+    }
+    fn default_auto() -> bool {
+        true
     }
 }
 

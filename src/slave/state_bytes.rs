@@ -7,13 +7,13 @@
 //! | --- | --- |
 //! | payload format | u32 = [`PAYLOAD_FORMAT`] |
 //! | interfaces `n` | u32 |
-//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces: u8 |
+//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces, auto: u8 |
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64 |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening); since when their indicators are quiet [2] f64 (f64::MAX: not) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -139,6 +139,7 @@ impl SlaveState {
         w.i32(p.integrator);
         w.i32(p.modes);
         w.u8(u8::from(p.nonlinear_forces));
+        w.u8(u8::from(p.auto));
         self.inputs.iter().for_each(|i| w.f64s(i));
         for d in &self.input_derivatives {
             w.f64s(&d[0]);
@@ -161,6 +162,8 @@ impl SlaveState {
                 w.f64s(&s.multipliers);
                 d.loads.iter().for_each(|l| w.f64s(l));
                 w.f64s(&d.gravity);
+                w.u8(u8::from(d.features.nonlinear_forces) | u8::from(d.features.stiffening) << 1);
+                w.f64s(&d.quiet_since);
             }
         }
     }
@@ -215,6 +218,15 @@ impl Slave {
             b => {
                 return Err(Error::new(format!(
                     "the serialized FMU state holds {b} for model.nonlinearForces: not a Boolean"
+                )))
+            }
+        };
+        p.auto = match r.u8("model.auto")? {
+            0 => false,
+            1 => true,
+            b => {
+                return Err(Error::new(format!(
+                    "the serialized FMU state holds {b} for model.auto: not a Boolean"
                 )))
             }
         };
@@ -277,6 +289,22 @@ impl Slave {
                 }
                 let mut gravity = [0.0; 3];
                 r.f64s(&mut gravity, "the gravity of the state")?;
+                let features = match r.u8("the terms in force")? {
+                    b @ 0..=3 => super::Features {
+                        nonlinear_forces: b & 1 != 0,
+                        stiffening: b & 2 != 0,
+                    },
+                    b => {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state holds {b} for the terms in force: not 0 to 3"
+                        )))
+                    }
+                };
+                let mut quiet_since = [0.0; 2];
+                r.f64s(
+                    &mut quiet_since,
+                    "the times since the terms' indicators are quiet",
+                )?;
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -289,6 +317,8 @@ impl Slave {
                     },
                     loads,
                     gravity,
+                    features,
+                    quiet_since,
                 })
             }
             b => {
@@ -356,8 +386,8 @@ fn check_parameters(p: &Parameters) -> Result<()> {
     if !(1..=3).contains(&p.stiffening) {
         return bad("model.stiffening", p.stiffening, "not 1, 2 or 3");
     }
-    if !(1..=2).contains(&p.integrator) {
-        return bad("solver.integrator", p.integrator, "not 1 or 2");
+    if !(1..=3).contains(&p.integrator) {
+        return bad("solver.integrator", p.integrator, "not 1, 2 or 3");
     }
     if p.frames < 1 {
         return bad("model.frames", p.frames, "must be at least 1");

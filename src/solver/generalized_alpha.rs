@@ -300,8 +300,9 @@ impl IterationMatrix {
                 &mut workspace,
             )?)
         };
-        let nonlinear = (body.options.nonlinear_forces && body.single_frame())
-            .then(|| NonlinearForceCorrection::new(body, free, &factor, &mut workspace));
+        let nonlinear = ((body.options.nonlinear_forces || body.nonlinear_forces_switchable)
+            && body.single_frame())
+        .then(|| NonlinearForceCorrection::new(body, free, &factor, &mut workspace));
         Ok(IterationMatrix {
             step_size: h,
             scheme: *scheme,
@@ -551,7 +552,12 @@ fn iterate(
     ws.anderson.reset();
     for iteration in 1..=settings.max_iterations {
         let kin = residual(body, free, state, loads, ws);
-        if let (1, Some(correction)) = (iteration, &mut matrix.nonlinear) {
+        // The correction only while f_nl is on (`model.auto` switches it between steps).
+        let nonlinear = matrix
+            .nonlinear
+            .as_mut()
+            .filter(|_| body.options.nonlinear_forces);
+        if let (1, Some(correction)) = (iteration, nonlinear) {
             // The f_nl Jacobian, frozen over the step at the predictor.
             let h_inv = body
                 .frame_weights
@@ -610,7 +616,11 @@ fn iterate(
         matrix
             .factor
             .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
-        if let Some(correction) = &matrix.nonlinear {
+        if let Some(correction) = matrix
+            .nonlinear
+            .as_ref()
+            .filter(|_| body.options.nonlinear_forces)
+        {
             correction.correct(&mut ws.reduced);
         }
         if let Some(constraint) = &mut matrix.constraint {
