@@ -23,11 +23,11 @@
 //! Models: `reducedStrain` with `f_nl` off (the default) and on, with `f_nl` and inertial
 //! stiffening both forced on (`model.auto = false`) and both allowed under `model.auto`, and
 //! `full`; Radau IIA and the reduced body with 8 modes (`OTHERS`). A last table (`model.auto`,
-//! issue 8) puts `auto` against `all on`: wall time, time saved, the largest difference of the two (it must stay within the iteration tolerance's
-//! reach) and that of `all off` (the effect of the terms) on B1 with 10 N and 0.01 N step loads
-//! (h = 1 ms, 0.2 s) and on B3 (h = 1e-2 s); its CSV rows have `relative_error` = difference /
-//! effect of the terms. Prints Markdown
-//! tables; with `--csv FILE` also writes one row per run:
+//! issue 8) puts `auto` against `all on`: wall time, time saved, the largest difference of the
+//! two (it must stay within the iteration tolerance's reach) and that of `all off` (the effect
+//! of the terms) on B1 with 10 N and 0.01 N step loads (h = 1 ms, 0.2 s) and on B3
+//! (h = 1e-2 s); its CSV rows have `relative_error` = difference / effect of the terms. Prints
+//! Markdown tables; with `--csv FILE` also writes one row per run:
 //! `problem,model,h,steps,wall_s,steps_per_s,max_error_m,relative_error` (model quoted).
 
 use flexbody::model::BodyFile;

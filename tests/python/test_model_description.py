@@ -85,7 +85,7 @@ PARAMETERS = (
     + vector("initial.velocity", 3)
     + vector("initial.angularVelocity", 3)
     + ["solver.stepSize", "solver.rhoInf", "solver.tolerance", "solver.maxIterations"]
-    + ["model.nonlinearForces", "model.auto"]
+    + ["model.nonlinearForces", "model.auto", "model.modes"]
 )
 
 
