@@ -1958,13 +1958,8 @@ impl Slave {
             return Ok(usize::MAX); // the explicit scheme factorises nothing
         }
         if let Some(radau) = &mut model.radau {
-            if let Some(i) = radau
-                .matrices
-                .iter()
-                .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
-            {
-                radau.matrices[i..].rotate_left(1);
-                return Ok(radau.matrices.len() - 1);
+            if let Some(i) = cached_matrix(&mut radau.matrices, h, |m| m.step_size) {
+                return Ok(i);
             }
             let started = std::time::Instant::now();
             let matrix = RadauMatrix::new(
@@ -1983,20 +1978,10 @@ impl Slave {
                     started.elapsed().as_secs_f64()
                 ),
             });
-            if radau.matrices.len() >= MATRIX_CACHE_SIZE {
-                radau.matrices.remove(0);
-            }
-            radau.matrices.push(matrix);
-            return Ok(radau.matrices.len() - 1);
+            return Ok(cache_matrix(&mut radau.matrices, matrix));
         }
-        if let Some(i) = model
-            .matrices
-            .iter()
-            .position(|m| (m.step_size - h).abs() <= 1e-9 * h)
-        {
-            // Most recently used last (a rotation of at most four entries: no allocation).
-            model.matrices[i..].rotate_left(1);
-            return Ok(model.matrices.len() - 1);
+        if let Some(i) = cached_matrix(&mut model.matrices, h, |m| m.step_size) {
+            return Ok(i);
         }
         let started = std::time::Instant::now();
         let matrix = IterationMatrix::new(
@@ -2015,12 +2000,7 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
-        if model.matrices.len() >= MATRIX_CACHE_SIZE {
-            // The least recently used one.
-            model.matrices.remove(0);
-        }
-        model.matrices.push(matrix);
-        Ok(model.matrices.len() - 1)
+        Ok(cache_matrix(&mut model.matrices, matrix))
     }
 
     /// Places the body rigidly and computes the consistent initial acceleration (DESIGN.md
@@ -2512,6 +2492,26 @@ fn prescribe_motion(
             );
         }
     }
+}
+
+/// Index of the factorization for step `h` in `cache`, moved to the end (most recently used
+/// last; a rotation of at most [`MATRIX_CACHE_SIZE`] entries: no allocation).
+fn cached_matrix<T>(cache: &mut [T], h: f64, step_size: impl Fn(&T) -> f64) -> Option<usize> {
+    let i = cache
+        .iter()
+        .position(|m| (step_size(m) - h).abs() <= 1e-9 * h)?;
+    cache[i..].rotate_left(1);
+    Some(cache.len() - 1)
+}
+
+/// Adds `matrix` to `cache`, evicting the least recently used (the first) when it is full;
+/// returns its index.
+fn cache_matrix<T>(cache: &mut Vec<T>, matrix: T) -> usize {
+    if cache.len() >= MATRIX_CACHE_SIZE {
+        cache.remove(0);
+    }
+    cache.push(matrix);
+    cache.len() - 1
 }
 
 /// The driving frame of motion interface `name` from its inputs: a rotation input within 1e-3 of
