@@ -2,7 +2,8 @@
 //! with the factor of the iteration matrix (the figures of issues 2 and 3).
 //!
 //! `cargo run --release --example step_cost [-- steps [body.json ...]]` (default: 2000 steps of
-//! the default cantilever, the motion-driven cantilever and a pinned variant). For each body and
+//! the default cantilever, its reduced body with 8 modes, the motion-driven cantilever and a
+//! pinned variant). For each body and
 //! h = 1e-4, 1e-3 s it prints DOF, nnz of K and of the factor, the median time of a solve and of a
 //! step, steps per second, iterations per step and the ratio step/solve. The load is B1's: 10 N at
 //! the tip; the pinned variant is the cantilever with its root face on a pin under gravity.
@@ -26,8 +27,13 @@ fn bodies(paths: &[String]) -> Vec<BodyFile> {
     let mut pinned = BodyFile::default_body();
     pinned.name = "pinned_cantilever".into();
     pinned.interfaces[0].kind = flexbody::model::InterfaceKind::Pin;
+    // The reduced body (issue 8): B1 on 8 fixed-interface modes and the interfaces' modes.
+    let mut reduced = BodyFile::default_body();
+    reduced.name = "cantilever_modes8".into();
+    reduced.model.modes = 8;
     vec![
         BodyFile::default_body(),
+        reduced,
         BodyFile::from_json(&driven).unwrap(),
         pinned,
     ]

@@ -2,10 +2,12 @@
 //! tables, with the machine and versions they were measured on, to `bench/results/<date>.md`.
 //!
 //! The suite (each an example that prints Markdown tables, see its own doc comment):
-//! * `step_cost`: the cost of one step against its floor, one pair of triangular solves;
+//! * `step_cost`: the cost of one step against its floor, one pair of triangular solves (the
+//!   reduced body with 8 modes among the bodies, to set beside the peers' CB-8);
 //! * `b3_table`: B3 through the slave for every model choice, `full` as the yardstick (issue 4);
 //! * `b2_drift`: B2's angular momentum and energy drift with and without `f_nl` and frames;
 //! * `work_precision`: run time against error on B1 and B3 for each formulation (CSV);
+//! * `soak`: 10⁶ steps of the undamped cantilever, energy drift and resident memory (issue 7);
 //! * `step_scaling`: a step against one solve from 384 to ~100k DOF (CSV);
 //! * the peers: `export_matrices` writes B1's mesh and matrices, `bench/peers.py` runs Exudyn's
 //!   floating frame of reference on them (CB-8 modes and all nodal DOF) in the pinned bench venv
@@ -61,6 +63,13 @@ const SUITE: &[Entry] = &[
         args: &[],
         quick_args: &["--quick"],
         csv: Some("work_precision"),
+    },
+    Entry {
+        title: "Soak: 10⁶ steps of the undamped cantilever (energy drift, resident memory)",
+        example: "soak",
+        args: &["1000000"],
+        quick_args: &["2000"],
+        csv: None,
     },
     Entry {
         title: "Per-step cost against the floor, 384 to ~100k DOF",
