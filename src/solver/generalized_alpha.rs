@@ -637,7 +637,12 @@ fn iterate(
         for (k, &i) in free.nodes.iter().enumerate() {
             let dx = -(rotation(i) * node(&ws.reduced, k));
             set_node(&mut ws.update, k, &dx);
-            largest = largest.max(dx.amax());
+            // A non-finite correction never counts as converged (f64::max would drop a NaN).
+            largest = if dx.iter().all(|v| v.is_finite()) {
+                largest.max(dx.amax())
+            } else {
+                f64::INFINITY
+            };
         }
         for (u, (&new, &old)) in ws.update[nf3..]
             .iter_mut()
