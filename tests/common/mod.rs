@@ -56,3 +56,15 @@ pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
 pub fn example_body_at(path: &std::path::Path) -> BodyFile {
     BodyFile::from_json(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
+
+/// B1's static tip deflection on the default mesh (m, negative): the fixed-root default body
+/// under 10 N, settled by 0.6 s of heavy damping (β = 2e-2 s, h = 1 ms).
+pub fn b1_settled_deflection() -> f64 {
+    let h = 1e-3;
+    let mut fixed = initialized_default(&[("damping.beta", 2e-2), ("tip.force[2]", -10.0)]);
+    let y0 = get(&mut fixed, "tip.position[2]");
+    for k in 0..600 {
+        fixed.do_step(k as f64 * h, h).unwrap();
+    }
+    get(&mut fixed, "tip.position[2]") - y0
+}
