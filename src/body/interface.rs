@@ -41,7 +41,7 @@ pub struct SetExpansion {
     /// The coordinates the set holds (fixed support, motion interface); empty otherwise.
     pub held: Vec<HeldCoordinate>,
     /// `Σ_i (w_i / W) S_ik`: the generalized load of a force alone when the reference point is
-    /// the centroid (then `f_i = w_i F / W` does not depend on the positions).
+    /// the centroid (to round-off; then `f_i = w_i F / W` does not depend on the positions).
     force_weights: Option<Vec<f64>>,
     /// Expanded positions, velocities, accelerations and loads of the set (4 × `3 n_set`).
     scratch: RefCell<Vec<f64>>,
@@ -115,7 +115,16 @@ impl NodeSet {
             reference_point: self.reference_point,
             expansion: None,
         };
-        let force_weights = (self.reference_point == fw.reference_centroid).then(|| {
+        // The reference point at the centroid up to round-off (1e-12 of the set's extent: a
+        // body file's point on the tip face's centre against the computed centroid) changes
+        // the torque of a force by at most 1e-12 of force × extent.
+        let extent = fw
+            .nodes
+            .iter()
+            .map(|&i| (node(&reduction.mesh_reference, i) - fw.reference_centroid).norm())
+            .fold(0.0, f64::max);
+        let centred = (self.reference_point - fw.reference_centroid).norm() <= 1e-12 * extent;
+        let force_weights = centred.then(|| {
             let mut w = vec![0.0; s];
             for (j, &wj) in fw.weights.iter().enumerate() {
                 for k in 0..s {

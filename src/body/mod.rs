@@ -15,6 +15,7 @@ pub use interface::NodeSet;
 pub use patches::Patches;
 pub use reduction::Reduction;
 
+use crate::fem::dense::DenseSymmetric;
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::sparse::BlockCsr3;
 use crate::fem::SymmetricCsr;
@@ -52,8 +53,12 @@ pub struct Body {
     pub mass_matrix: SymmetricCsr,
     /// Small-strain stiffness `K` (N/m), `3N × 3N`.
     pub stiffness_matrix: SymmetricCsr,
-    /// The same `K` by 3×3 blocks, for the products of the hot path.
-    stiffness_blocks: BlockCsr3,
+    /// The same `K` for the products of the hot path: by 3×3 blocks, or dense for a reduced
+    /// body.
+    stiffness_product: MatrixProduct,
+    /// A reduced body's `Ms` (dense) for [`Body::mass_times`]; `None`: the compressed
+    /// `mass_matrix`.
+    dense_mass: Option<DenseSymmetric>,
     /// Row sums of `Ms` (kg): `M (1 ⊗ a) = (row sums) ⊗ a`, the exact nodal loads of a uniform
     /// acceleration field and the weights of the centre of mass.
     pub mass_row_sums: Vec<f64>,
@@ -79,6 +84,25 @@ pub struct Body {
     /// correction of `f_nl` (computed once per step size) even while the term is off, so that
     /// switching it on needs no new factorization.
     pub nonlinear_forces_switchable: bool,
+}
+
+/// How a constant `3N × 3N` matrix is stored for the products of the hot path.
+#[derive(Debug, Clone)]
+enum MatrixProduct {
+    /// By 3×3 blocks (a mesh: sparse).
+    Blocks(BlockCsr3),
+    /// Dense (a reduced body: every entry is non-zero).
+    Dense(DenseSymmetric),
+}
+
+impl MatrixProduct {
+    /// `y = A x`, no allocation.
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        match self {
+            MatrixProduct::Blocks(a) => a.mul_vec(x, y),
+            MatrixProduct::Dense(a) => a.mul_vec(x, y),
+        }
+    }
 }
 
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
@@ -143,7 +167,8 @@ impl Body {
         Body {
             reference,
             mass_matrix,
-            stiffness_blocks: BlockCsr3::from_csr(&stiffness_matrix),
+            stiffness_product: MatrixProduct::Blocks(BlockCsr3::from_csr(&stiffness_matrix)),
+            dense_mass: None,
             stiffness_matrix,
             mass_row_sums,
             total_mass,
@@ -168,7 +193,10 @@ impl Body {
         Body {
             reference: reduction.reference.clone(),
             mass_matrix: reduction.mass_matrix.clone(),
-            stiffness_blocks: BlockCsr3::from_csr(&reduction.stiffness_matrix),
+            stiffness_product: MatrixProduct::Dense(DenseSymmetric::from_csr(
+                &reduction.stiffness_matrix,
+            )),
+            dense_mass: Some(DenseSymmetric::from_csr(&reduction.mass_matrix)),
             stiffness_matrix: reduction.stiffness_matrix.clone(),
             mass_row_sums,
             total_mass,
@@ -249,6 +277,9 @@ impl Body {
     /// `y = M v = (Ms ⊗ I3) v` for a flat `3N` vector (no allocation: `Ms` acts on the three
     /// directions of each node at once).
     pub fn mass_times(&self, v: &[f64], y: &mut [f64]) {
+        if let Some(dense) = &self.dense_mass {
+            return dense.mul_nodes(v, y);
+        }
         let ms = &self.mass_matrix;
         for i in 0..ms.n {
             let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
@@ -304,7 +335,7 @@ impl Body {
             let scratch = scratch.patch.as_mut().expect("patch scratch");
             patches.internal_force(x, self.options.nonlinear_forces, scratch, g)
         } else {
-            self.stiffness_blocks.mul_vec(ubar, g);
+            self.stiffness_product.mul_vec(ubar, g);
             0.5 * dot(ubar, g)
         };
         if let Some(kg) = geometric_stiffness {
@@ -328,7 +359,7 @@ impl Body {
             let (alpha, beta) = (self.options.damping_alpha, self.options.damping_beta);
             let fd = &mut scratch.damping_force;
             if beta != 0.0 {
-                self.stiffness_blocks.mul_vec(rate, fd);
+                self.stiffness_product.mul_vec(rate, fd);
                 fd.iter_mut().for_each(|v| *v *= beta);
             } else {
                 fd.fill(0.0);
@@ -442,7 +473,7 @@ impl Body {
 
     /// `y = K x` (3×3-block product, no allocation).
     pub fn stiffness_product(&self, x: &[f64], y: &mut [f64]) {
-        self.stiffness_blocks.mul_vec(x, y);
+        self.stiffness_product.mul_vec(x, y);
     }
 
     /// Strain energy of positions `x` (J): `V = ½ ūᵀ K ū`, or the St. Venant–Kirchhoff energy

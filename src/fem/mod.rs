@@ -3,6 +3,7 @@
 //! DOF numbering everywhere: `3 * node + direction`.
 
 pub mod assembly;
+pub mod dense;
 pub mod element;
 pub mod geometric;
 pub mod material;

@@ -1,8 +1,15 @@
 //! Sparse Cholesky `A = L Lᵀ` (faer, supernodal, AMD ordering): the symbolic analysis once per
 //! pattern, the numeric factorization once per step size, and solves that take their workspace so
 //! that a time step does not allocate.
+//!
+//! A dense matrix of moderate size (a reduced body's, [`crate::body::reduction`]) also keeps its
+//! explicit inverse `A⁻¹ = L⁻ᵀ L⁻¹`, computed from the factor: a solve is then one SIMD
+//! matrix–vector product instead of two triangular solves, whose dependency chain dominates at
+//! this size (n = 168: 4.3 µs against 11.4 µs). The iterations that use the solve converge to
+//! the same solution either way (they only apply `A⁻¹` to a residual).
 
 use crate::error::{Error, Result};
+use crate::fem::dense::DenseSymmetric;
 use crate::fem::SymmetricCsr;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltParams;
@@ -11,7 +18,11 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side, Spec};
+use faer::{Conj, Mat, MatMut, Par, Side, Spec};
+
+/// A dense matrix up to this dimension keeps its explicit inverse for the solves (its `n²`
+/// doubles: 8 MB at this size; a reduced body has `3s` ≲ 300).
+pub const DENSE_INVERSE_LIMIT: usize = 1000;
 
 /// The factor of a symmetric positive definite matrix.
 pub struct SparseCholesky {
@@ -27,11 +38,15 @@ pub struct SparseCholesky {
     factor_values: Vec<f64>,
     /// Workspace of the numeric factorization.
     factor_workspace: MemBuffer,
+    /// `A⁻¹` when `A` is dense and at most [`DENSE_INVERSE_LIMIT`] in dimension.
+    inverse: Option<DenseSymmetric>,
 }
 
 /// Workspace for [`SparseCholesky::solve_in_place`], sized by [`SparseCholesky::solve_scratch`].
 pub struct SolveWorkspace {
     buffer: MemBuffer,
+    /// The right-hand side while `A⁻¹` multiplies it (length `n` with an explicit inverse).
+    rhs: Vec<f64>,
 }
 
 impl SparseCholesky {
@@ -71,6 +86,7 @@ impl SparseCholesky {
             lower_row_idx,
             symbolic,
             factor_workspace,
+            inverse: None,
         };
         this.refactor(matrix)?;
         Ok(this)
@@ -132,8 +148,12 @@ impl SparseCholesky {
             MemStack::new(&mut self.factor_workspace),
             Spec::<LltParams, f64>::default(),
         );
+        let dense = self.lower_values.len() == self.n * (self.n + 1) / 2;
         match result {
-            Ok(_) => Ok(()),
+            Ok(_) => {
+                self.inverse = (dense && self.n <= DENSE_INVERSE_LIMIT).then(|| self.invert());
+                Ok(())
+            }
             Err(e) => Err(Error::new(format!(
                 "sparse Cholesky: the matrix ({n}×{n}) is not positive definite ({e:?}, index in the AMD-permuted order)",
                 n = self.n
@@ -141,14 +161,34 @@ impl SparseCholesky {
         }
     }
 
+    /// `A⁻¹` from the factor: the solves of the `n` unit vectors (allocates; once per
+    /// factorization). Symmetrised, as `A⁻¹` is.
+    fn invert(&self) -> DenseSymmetric {
+        let n = self.n;
+        let mut inverse = Mat::<f64>::identity(n, n);
+        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(n, Par::Seq));
+        LltRef::<'_, usize, f64>::new(&self.symbolic, &self.factor_values)
+            .solve_in_place_with_conj(
+                Conj::No,
+                inverse.as_mut(),
+                Par::Seq,
+                MemStack::new(&mut buffer),
+            );
+        DenseSymmetric::new(Mat::from_fn(n, n, |i, j| {
+            0.5 * (inverse[(i, j)] + inverse[(j, i)])
+        }))
+    }
+
     /// Workspace for [`Self::solve_in_place`] (allocate once, reuse for every solve).
     pub fn solve_scratch(&self) -> SolveWorkspace {
         SolveWorkspace {
             buffer: MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq)),
+            rhs: vec![0.0; if self.inverse.is_some() { self.n } else { 0 }],
         }
     }
 
-    /// `rhs ← A⁻¹ rhs`: one forward and one backward triangular solve, no allocation.
+    /// `rhs ← A⁻¹ rhs`: one forward and one backward triangular solve (or the product with the
+    /// explicit inverse of a dense matrix), no allocation.
     /// Panics if `rhs.len() != self.dim()` or the workspace belongs to another factor size.
     pub fn solve_in_place(&self, rhs: &mut [f64], workspace: &mut SolveWorkspace) {
         assert_eq!(
@@ -156,6 +196,11 @@ impl SparseCholesky {
             self.n,
             "SparseCholesky::solve_in_place: wrong rhs length"
         );
+        if let Some(inverse) = &self.inverse {
+            workspace.rhs.copy_from_slice(rhs);
+            inverse.mul_vec(&workspace.rhs, rhs);
+            return;
+        }
         let llt = LltRef::<'_, usize, f64>::new(&self.symbolic, &self.factor_values);
         let rhs = MatMut::from_column_major_slice_mut(rhs, self.n, 1);
         llt.solve_in_place_with_conj(
@@ -215,6 +260,42 @@ mod tests {
             .map(|(p, q)| (p - q).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-10, "max error {err}");
+    }
+
+    #[test]
+    fn a_dense_matrix_solves_with_its_inverse() {
+        // A = B + n I with B_ij = 1/(1 + |i − j|): dense, SPD, condition number < 10, so
+        // A⁻¹ b has round-off error ≲ 1e-15 relative; refactor updates the inverse.
+        let n = 40;
+        let entry = |i: usize, j: usize| {
+            1.0 / (1.0 + (i as f64 - j as f64).abs()) + if i == j { n as f64 } else { 0.0 }
+        };
+        let t: Vec<_> = (0..n)
+            .flat_map(|i| (0..n).map(move |j| (i, j, entry(i, j))))
+            .collect();
+        let a = SymmetricCsr::from_triplets(n, &t);
+        let mut llt = SparseCholesky::new(&a).unwrap();
+        assert!(llt.inverse.is_some(), "a dense matrix keeps its inverse");
+        let x: Vec<f64> = (0..n).map(|i| (i as f64).cos()).collect();
+        for scale in [1.0, 3.0] {
+            let mut scaled = a.clone();
+            scaled.values.iter_mut().for_each(|v| *v *= scale);
+            llt.refactor(&scaled).unwrap();
+            let mut b = vec![0.0; n];
+            scaled.mul_vec(&x, &mut b);
+            let mut ws = llt.solve_scratch();
+            llt.solve_in_place(&mut b, &mut ws);
+            let err = x
+                .iter()
+                .zip(&b)
+                .map(|(p, q)| (p - q).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-13, "scale {scale}: max error {err}");
+        }
+        assert!(SparseCholesky::new(&laplacian(n))
+            .unwrap()
+            .inverse
+            .is_none());
     }
 
     #[test]
