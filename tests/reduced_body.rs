@@ -1,7 +1,7 @@
 //! The reduced body (`model.modes`, `body::reduction`) against the full mesh: B1's static
 //! deflection and bending frequencies and a second boundary set moved rigidly (library level), the
-//! step response through the slave, a
-//! rotating motion interface, a free tumbling body, the FMU state and the parameter checks.
+//! step response through the slave, a rotating motion interface, a free tumbling body, the FMU
+//! state and the parameter checks.
 
 mod common;
 use common::*;
