@@ -323,6 +323,8 @@ struct Outputs {
     /// Per interface: force[3], torque[3], then motion (position, rotation, velocity, angular
     /// velocity, acceleration, angular acceleration) in value-reference slot order.
     interfaces: Vec<[f64; 30]>,
+    /// Scratch `M ẋ` (flat, the body's size; resized only when the model changes).
+    momentum: Vec<f64>,
 }
 
 /// A message for the importer's logger that is not an error: `category` is one of the declared
@@ -1945,6 +1947,8 @@ impl Slave {
         // The backups have the old model's size (a changed model.modes changes it).
         self.backup = None;
         self.retry_backup = None;
+        let size = self.model.as_ref().map_or(0, |m| m.body.reference.len());
+        self.outputs.momentum = vec![0.0; size];
         Ok(())
     }
 
@@ -2210,12 +2214,11 @@ impl Slave {
         acom /= m;
         self.outputs.body_acceleration = acom.into();
         let (mut angular, mut kinetic) = (Vector3::zeros(), 0.0);
-        let ms = &body.mass_matrix;
-        for i in 0..ms.n {
-            let mut mv = Vector3::zeros();
-            for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
-                mv += ms.values[k] * node(&state.velocity, ms.col_idx[k]);
-            }
+        let momentum = &mut self.outputs.momentum;
+        momentum.resize(state.velocity.len(), 0.0); // sized by `finish_model`: no allocation
+        body.mass_times(&state.velocity, momentum);
+        for i in 0..body.node_count() {
+            let mv = node(momentum, i);
             angular += (node(&state.position, i) - body.unit(i) * com).cross(&mv);
             kinetic += 0.5 * node(&state.velocity, i).dot(&mv);
         }

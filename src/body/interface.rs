@@ -313,16 +313,19 @@ impl NodeSet {
 }
 
 impl SetExpansion {
-    /// `x_j = Σ_k S_jk q_k` for the set's nodes `j` (flat `3 n_set`).
+    /// `x_j = Σ_k S_jk q_k` for the set's nodes `j` (flat `3 n_set`): the product of the set's
+    /// rows of `S` (`n_set × s`) with the `s × 3` matrix of the `q_k` (faer, SIMD; no allocation).
     fn expand(&self, q: &[f64], out: &mut [f64]) {
         let s = self.fields;
-        for (j, row) in self.rows.chunks_exact(s).enumerate() {
-            let mut xj = Vector3::zeros();
-            for (k, &sk) in row.iter().enumerate() {
-                xj += sk * node(q, k);
-            }
-            set_node(out, j, &xj);
-        }
+        let n_set = self.rows.len() / s;
+        faer::linalg::matmul::matmul(
+            faer::MatMut::from_row_major_slice_mut(&mut out[..3 * n_set], n_set, 3),
+            faer::Accum::Replace,
+            faer::MatRef::from_row_major_slice(&self.rows, n_set, s),
+            faer::MatRef::from_row_major_slice(&q[..3 * s], s, 3),
+            1.0,
+            faer::Par::Seq,
+        );
     }
 
     fn distribute(&self, q: &[f64], force: &Vector3<f64>, torque: &Vector3<f64>, f: &mut [f64]) {
