@@ -7,7 +7,9 @@ mod common;
 use common::*;
 use flexbody::body::{NodeSet, Reduction};
 use flexbody::fem::modal::lowest_eigenpairs;
-use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::fem::{
+    lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial, SymmetricCsr,
+};
 use flexbody::mesh::{Mesh, NodeSelector};
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
@@ -66,6 +68,30 @@ impl B1 {
             / fw.total_weight
     }
 
+    /// Steel's `K` and `Ms` on the mesh, and the reduction with `boundary` sets, `loaded` sets
+    /// and `modes` fixed-interface modes.
+    fn reduced(
+        &self,
+        boundary: &[&NodeSet],
+        loaded: &[&NodeSet],
+        modes: usize,
+    ) -> (SymmetricCsr, SymmetricCsr, Reduction) {
+        let material = IsotropicMaterial::STEEL;
+        let k = stiffness_matrix(&self.mesh, &material);
+        let ms = scalar_mass_matrix(&self.mesh, material.density);
+        let reduction = Reduction::new(
+            &self.reference,
+            &ms,
+            &k,
+            &self.lumped,
+            boundary,
+            loaded,
+            modes,
+        )
+        .unwrap();
+        (k, ms, reduction)
+    }
+
     /// DOFs not on the root face.
     fn free_dofs(&self) -> Vec<usize> {
         let root = &self.root.frame_weights.nodes;
@@ -74,6 +100,25 @@ impl B1 {
             .flat_map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
             .collect()
     }
+}
+
+/// The full mesh's static displacement: `u` as given off the `free` DOFs, on them
+/// `K_ff u_f = f_f − (K u)_f` for the nodal loads `load`.
+fn static_displacement(
+    k: &SymmetricCsr,
+    free: &[usize],
+    load: &[f64],
+    mut u: Vec<f64>,
+) -> Vec<f64> {
+    let mut k_u = vec![0.0; u.len()];
+    k.mul_vec(&u, &mut k_u);
+    let mut u_free: Vec<f64> = free.iter().map(|&d| load[d] - k_u[d]).collect();
+    let factor = SparseCholesky::new(&k.submatrix(free)).unwrap();
+    factor.solve_in_place(&mut u_free, &mut factor.solve_scratch());
+    for (&d, &v) in free.iter().zip(&u_free) {
+        u[d] = v;
+    }
+    u
 }
 
 /// The generalized eigenvalues `K v = λ M v` of dense symmetric `K`, `M` (M positive definite),
@@ -113,19 +158,7 @@ fn hz(lambda: f64) -> f64 {
 #[test]
 fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
     let mut b1 = B1::new();
-    let material = IsotropicMaterial::STEEL;
-    let k = stiffness_matrix(&b1.mesh, &material);
-    let ms = scalar_mass_matrix(&b1.mesh, material.density);
-    let reduction = Reduction::new(
-        &b1.reference,
-        &ms,
-        &k,
-        &b1.lumped,
-        &[&b1.root],
-        &[&b1.tip],
-        4,
-    )
-    .unwrap();
+    let (k, ms, reduction) = b1.reduced(&[&b1.root], &[&b1.tip], 4);
 
     // Full mesh.
     let free = b1.free_dofs();
@@ -136,13 +169,7 @@ fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
         &Vector3::zeros(),
         &mut load,
     );
-    let mut u_free: Vec<f64> = free.iter().map(|&d| load[d]).collect();
-    let factor = SparseCholesky::new(&k.submatrix(&free)).unwrap();
-    factor.solve_in_place(&mut u_free, &mut factor.solve_scratch());
-    let mut u = vec![0.0; b1.reference.len()];
-    for (&d, &v) in free.iter().zip(&u_free) {
-        u[d] = v;
-    }
+    let u = static_displacement(&k, &free, &load, vec![0.0; b1.reference.len()]);
     let full_deflection = b1.tip_deflection(&u);
     let full_modes = lowest_eigenpairs(
         &k.submatrix(&free),
@@ -244,19 +271,7 @@ fn step_response(modes: f64) -> (Vec<f64>, f64) {
 #[test]
 fn a_second_boundary_set_moves_the_reduced_body_as_it_moves_the_full_mesh() {
     let b1 = B1::new();
-    let material = IsotropicMaterial::STEEL;
-    let k = stiffness_matrix(&b1.mesh, &material);
-    let ms = scalar_mass_matrix(&b1.mesh, material.density);
-    let reduction = Reduction::new(
-        &b1.reference,
-        &ms,
-        &k,
-        &b1.lumped,
-        &[&b1.root, &b1.tip],
-        &[],
-        2,
-    )
-    .unwrap();
+    let (k, _, reduction) = b1.reduced(&[&b1.root, &b1.tip], &[], 2);
     let position = |x: &[f64], i: usize| Vector3::new(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
     let translation = Vector3::new(2e-4, 1e-3, -5e-4);
     let rotation = Rotation3::from_axis_angle(&Vector3::z_axis(), 1e-3).into_inner();
@@ -277,15 +292,7 @@ fn a_second_boundary_set_moves_the_reduced_body_as_it_moves_the_full_mesh() {
         .into_iter()
         .filter(|d| !tip_nodes.contains(&(d / 3)))
         .collect();
-    let mut k_u = vec![0.0; n3];
-    k.mul_vec(&u_held, &mut k_u);
-    let mut u_free: Vec<f64> = free.iter().map(|&d| -k_u[d]).collect();
-    let factor = SparseCholesky::new(&k.submatrix(&free)).unwrap();
-    factor.solve_in_place(&mut u_free, &mut factor.solve_scratch());
-    let mut u_full = u_held;
-    for (&d, &v) in free.iter().zip(&u_free) {
-        u_full[d] = v;
-    }
+    let u_full = static_displacement(&k, &free, &vec![0.0; n3], u_held);
 
     // Reduced: the tip's held coordinates q = p + Q d (a point) or Q d (a direction).
     let mut dq = vec![0.0; 3 * reduction.field_count];
