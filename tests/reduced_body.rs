@@ -257,11 +257,6 @@ fn step_response(modes: f64) -> (Vec<f64>, f64) {
     (history, started.elapsed().as_secs_f64())
 }
 
-/// The step response through the whole slave converges to the full mesh's as modes are added:
-/// the truncated modes (above f_{n+1}) keep their static part through the attachment modes and
-/// lose only their dynamic part, which shrinks with f_{n+1}. With 8 modes (f9 ≈ 900 Hz) the
-/// largest deviation over the first half period is within the 0.5 % of the peak
-/// deflection, and below a tenth of the deviation with 2 modes.
 /// Two boundary sets: B1's root clamped and its tip face moved rigidly (a translation and a
 /// rotation about its reference point), static, reduced (2 modes) against the full mesh with the
 /// same motion prescribed on the tip face. The second set's constraint modes are the static
@@ -344,6 +339,11 @@ fn a_second_boundary_set_moves_the_reduced_body_as_it_moves_the_full_mesh() {
     assert!(tip_error < 1e-12, "{tip_error:e}");
 }
 
+/// The step response through the whole slave converges to the full mesh's as modes are added:
+/// the truncated modes (above f_{n+1}) keep their static part through the attachment modes and
+/// lose only their dynamic part, which shrinks with f_{n+1}. With 8 modes (f9 ≈ 900 Hz) the
+/// largest deviation over the first half period is within the 0.5 % of the peak
+/// deflection, and below a tenth of the deviation with 2 modes.
 #[test]
 fn step_response_converges_to_the_full_mesh_with_the_number_of_modes() {
     let (full, full_time) = step_response(0.0);

@@ -27,8 +27,14 @@
 //!    `u = φ e_d` on the set (other boundary sets held). The first set needs none: the sets only
 //!    ever move rigidly, and the response to a rigid motion of the first set with the others
 //!    moving along is that rigid motion of the whole body, which the affine fields hold (the
-//!    others' constraint modes add their motion relative to it). B1 with 8 modes has 46 scalar
-//!    fields (138 coordinates) without its root's constraint modes, 62 (186) with them;
+//!    others' constraint modes add their motion relative to it). This holds to first order in
+//!    the set's rotation against the co-moving frame: turned by `θ` against it (a bent body),
+//!    the set's local data has a non-rigid part of `O(θ²)`, which the mesh answers with a field
+//!    at the support and this basis with the affine fields only. That is of the order of the
+//!    reduced strain's own small-rotation error; on B3 (a 10 m beam, 0.57 m peak deflection)
+//!    the reduced body's error against `full` differs from the mesh body's by 2e-6 m
+//!    (`cargo xtask bench`, 2026-11-23). B1 with 8 modes has 46 scalar fields (138
+//!    coordinates) without its root's constraint modes, 62 (186) with them;
 //! 3. the `n` lowest fixed-interface modes (boundary sets held; free-free modes when there is no
 //!    boundary set, computed with a small shift);
 //! 4. attachment modes: for each force interface, the static response to a unit force and a

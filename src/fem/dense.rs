@@ -33,6 +33,11 @@ impl DenseSymmetric {
         DenseSymmetric { matrix }
     }
 
+    /// The matrix, to overwrite in place (the caller keeps it symmetric).
+    pub fn as_mut(&mut self) -> MatMut<'_, f64> {
+        self.matrix.as_mut()
+    }
+
     /// Dimension `n`.
     pub fn dim(&self) -> usize {
         self.matrix.nrows()

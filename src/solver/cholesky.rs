@@ -40,6 +40,8 @@ pub struct SparseCholesky {
     factor_workspace: MemBuffer,
     /// `A⁻¹` when `A` is dense and at most [`DENSE_INVERSE_LIMIT`] in dimension.
     inverse: Option<DenseSymmetric>,
+    /// The unit-vector solves behind `inverse` and their workspace (kept for refactorizations).
+    inverse_workspace: Option<(Mat<f64>, MemBuffer)>,
 }
 
 /// Workspace for [`SparseCholesky::solve_in_place`], sized by [`SparseCholesky::solve_scratch`].
@@ -87,6 +89,7 @@ impl SparseCholesky {
             symbolic,
             factor_workspace,
             inverse: None,
+            inverse_workspace: None,
         };
         this.refactor(matrix)?;
         Ok(this)
@@ -139,6 +142,8 @@ impl SparseCholesky {
             &self.lower_row_idx,
         );
         let a = SparseColMatRef::new(pattern, &self.lower_values);
+        // A failed factorization must not leave the previous matrix's inverse answering solves.
+        let had_inverse = self.inverse.take();
         let result = self.symbolic.factorize_numeric_llt::<f64>(
             &mut self.factor_values,
             a,
@@ -151,7 +156,10 @@ impl SparseCholesky {
         let dense = self.lower_values.len() == self.n * (self.n + 1) / 2;
         match result {
             Ok(_) => {
-                self.inverse = (dense && self.n <= DENSE_INVERSE_LIMIT).then(|| self.invert());
+                self.inverse = had_inverse;
+                if dense && self.n <= DENSE_INVERSE_LIMIT {
+                    self.update_inverse();
+                }
                 Ok(())
             }
             Err(e) => Err(Error::new(format!(
@@ -161,22 +169,35 @@ impl SparseCholesky {
         }
     }
 
-    /// `A⁻¹` from the factor: the solves of the `n` unit vectors (allocates; once per
-    /// factorization). Symmetrised, as `A⁻¹` is.
-    fn invert(&self) -> DenseSymmetric {
+    /// `A⁻¹` from the factor: the solves of the `n` unit vectors, symmetrised (as `A⁻¹` is).
+    /// Allocates at the first factorization only; a refactorization (Newton's, every
+    /// iteration) reuses the storage.
+    fn update_inverse(&mut self) {
         let n = self.n;
-        let mut inverse = Mat::<f64>::identity(n, n);
-        let mut buffer = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(n, Par::Seq));
-        LltRef::<'_, usize, f64>::new(&self.symbolic, &self.factor_values)
-            .solve_in_place_with_conj(
-                Conj::No,
-                inverse.as_mut(),
-                Par::Seq,
-                MemStack::new(&mut buffer),
-            );
-        DenseSymmetric::new(Mat::from_fn(n, n, |i, j| {
-            0.5 * (inverse[(i, j)] + inverse[(j, i)])
-        }))
+        let symbolic = &self.symbolic;
+        let (solves, buffer) = self.inverse_workspace.get_or_insert_with(|| {
+            (
+                Mat::<f64>::zeros(n, n),
+                MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(n, Par::Seq)),
+            )
+        });
+        solves.fill(0.0);
+        solves.diagonal_mut().fill(1.0);
+        LltRef::<'_, usize, f64>::new(symbolic, &self.factor_values).solve_in_place_with_conj(
+            Conj::No,
+            solves.as_mut(),
+            Par::Seq,
+            MemStack::new(buffer),
+        );
+        let inverse = self
+            .inverse
+            .get_or_insert_with(|| DenseSymmetric::new(Mat::zeros(n, n)));
+        let mut target = inverse.as_mut();
+        for j in 0..n {
+            for i in 0..n {
+                target[(i, j)] = 0.5 * (solves[(i, j)] + solves[(j, i)]);
+            }
+        }
     }
 
     /// Workspace for [`Self::solve_in_place`] (allocate once, reuse for every solve).

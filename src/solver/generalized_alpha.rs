@@ -672,7 +672,11 @@ fn iterate(
         {
             *u = new - old;
         }
-        if largest.is_finite() && largest > settings.absolute_tolerance && matrix.newton.is_none() {
+        // Decided on the plain correction, which is then the one applied: Anderson's mixed
+        // update is not what the estimate describes.
+        let converged = largest <= settings.absolute_tolerance
+            || remaining_error(largest, last_correction) <= settings.absolute_tolerance;
+        if largest.is_finite() && !converged && matrix.newton.is_none() {
             ws.anderson.accelerate(&ws.iterate, &mut ws.update);
         }
         for (k, &i) in free.nodes.iter().enumerate() {
@@ -696,11 +700,8 @@ fn iterate(
                 state.time
             )));
         }
-        let previous_correction = last_correction;
         last_correction = largest;
-        if largest <= settings.absolute_tolerance
-            || remaining_error(largest, previous_correction) <= settings.absolute_tolerance
-        {
+        if converged {
             let prev = &ws.previous;
             for &i in &free.nodes {
                 for d in 3 * i..3 * i + 3 {
