@@ -1961,50 +1961,53 @@ impl Slave {
         if model.explicit.is_some() {
             return Ok(usize::MAX); // the explicit scheme factorises nothing
         }
+        let events = &mut self.events;
         if let Some(radau) = &mut model.radau {
-            if let Some(i) = cached_matrix(&mut radau.matrices, h, |m| m.step_size) {
-                return Ok(i);
-            }
-            let started = std::time::Instant::now();
-            let matrix = RadauMatrix::new(
-                &model.body,
-                &model.free,
-                &radau.tableau,
+            return cached_factorization(
+                &mut radau.matrices,
                 h,
-                p.damping_alpha,
-                p.damping_beta,
-            )?;
-            self.events.push(LogEvent {
-                category: "logEvents",
-                message: format!(
-                    "factorised the Radau IIA matrices for internal step h = {h:e} s: real Cholesky nnz(L) = {} and complex LU ({:.3} s); they serve every step of this size",
-                    matrix.real_factor_nnz(),
-                    started.elapsed().as_secs_f64()
-                ),
-            });
-            return Ok(cache_matrix(&mut radau.matrices, matrix));
+                |m| m.step_size,
+                || {
+                    RadauMatrix::new(
+                        &model.body,
+                        &model.free,
+                        &radau.tableau,
+                        h,
+                        p.damping_alpha,
+                        p.damping_beta,
+                    )
+                },
+                |matrix, seconds| {
+                    format!(
+                    "factorised the Radau IIA matrices for internal step h = {h:e} s: real Cholesky nnz(L) = {} and complex LU ({seconds:.3} s); they serve every step of this size",
+                    matrix.real_factor_nnz()
+                )
+                },
+                events,
+            );
         }
-        if let Some(i) = cached_matrix(&mut model.matrices, h, |m| m.step_size) {
-            return Ok(i);
-        }
-        let started = std::time::Instant::now();
-        let matrix = IterationMatrix::new(
-            &model.body,
-            &model.free,
-            &model.scheme,
+        cached_factorization(
+            &mut model.matrices,
             h,
-            p.damping_alpha,
-            p.damping_beta,
-        )?;
-        self.events.push(LogEvent {
-            category: "logEvents",
-            message: format!(
-                "factorised the iteration matrix for internal step h = {h:e} s: nnz(L) = {} ({:.3} s); it serves every step of this size",
-                matrix.factor.factor_nnz(),
-                started.elapsed().as_secs_f64()
-            ),
-        });
-        Ok(cache_matrix(&mut model.matrices, matrix))
+            |m| m.step_size,
+            || {
+                IterationMatrix::new(
+                    &model.body,
+                    &model.free,
+                    &model.scheme,
+                    h,
+                    p.damping_alpha,
+                    p.damping_beta,
+                )
+            },
+            |matrix, seconds| {
+                format!(
+                "factorised the iteration matrix for internal step h = {h:e} s: nnz(L) = {} ({seconds:.3} s); it serves every step of this size",
+                matrix.factor.factor_nnz()
+            )
+            },
+            events,
+        )
     }
 
     /// Places the body rigidly and computes the consistent initial acceleration (DESIGN.md
@@ -2497,24 +2500,36 @@ fn prescribe_motion(
     }
 }
 
-/// Index of the factorization for step `h` in `cache`, moved to the end (most recently used
-/// last; a rotation of at most [`MATRIX_CACHE_SIZE`] entries: no allocation).
-fn cached_matrix<T>(cache: &mut [T], h: f64, step_size: impl Fn(&T) -> f64) -> Option<usize> {
-    let i = cache
+/// Index of the factorization for step `h` in `cache`, most recently used last (a rotation of
+/// at most [`MATRIX_CACHE_SIZE`] entries: no allocation on a hit). On a miss `factorise()` builds
+/// it, the least recently used (the first) is evicted when the cache is full, and
+/// `describe(matrix, seconds)` is logged under `logEvents`.
+fn cached_factorization<T>(
+    cache: &mut Vec<T>,
+    h: f64,
+    step_size: impl Fn(&T) -> f64,
+    factorise: impl FnOnce() -> Result<T>,
+    describe: impl Fn(&T, f64) -> String,
+    events: &mut Vec<LogEvent>,
+) -> Result<usize> {
+    if let Some(i) = cache
         .iter()
-        .position(|m| (step_size(m) - h).abs() <= 1e-9 * h)?;
-    cache[i..].rotate_left(1);
-    Some(cache.len() - 1)
-}
-
-/// Adds `matrix` to `cache`, evicting the least recently used (the first) when it is full;
-/// returns its index.
-fn cache_matrix<T>(cache: &mut Vec<T>, matrix: T) -> usize {
+        .position(|m| (step_size(m) - h).abs() <= 1e-9 * h)
+    {
+        cache[i..].rotate_left(1);
+        return Ok(cache.len() - 1);
+    }
+    let started = std::time::Instant::now();
+    let matrix = factorise()?;
+    events.push(LogEvent {
+        category: "logEvents",
+        message: describe(&matrix, started.elapsed().as_secs_f64()),
+    });
     if cache.len() >= MATRIX_CACHE_SIZE {
         cache.remove(0);
     }
     cache.push(matrix);
-    cache.len() - 1
+    Ok(cache.len() - 1)
 }
 
 /// The driving frame of motion interface `name` from its inputs: a rotation input within 1e-3 of

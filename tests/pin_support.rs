@@ -19,10 +19,6 @@ const PENDULUM: &str = r#"{
   "solver": { "stepSize": 1e-3, "rhoInf": 0.9, "tolerance": 1e-10, "maxIterations": 25 }
 }"#;
 
-fn vector(s: &mut Slave, name: &str) -> Vector3<f64> {
-    Vector3::from_fn(|k, _| get(s, &format!("{name}[{}]", k + 1)))
-}
-
 /// A steel-dense beam, 100 times stiffer than steel (nearly rigid), pinned at the centre of its
 /// root face, released 0.05 rad from hanging: period `2π sqrt(I_pivot / (m g d))` with
 /// `I_pivot = m (L²/3 + a²/12)`, `d = L/2`, within 0.5 % (the finite amplitude adds θ₀²/16 =

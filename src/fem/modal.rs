@@ -162,15 +162,7 @@ mod tests {
         // Fixed–fixed chain of n unit masses and unit springs: K = tridiag(−1, 2, −1), M = I,
         // eigenvalues 4 sin²(iπ / (2(n+1))).
         let n = 60;
-        let mut t = Vec::new();
-        for i in 0..n {
-            t.push((i, i, 2.0));
-            if i + 1 < n {
-                t.push((i, i + 1, -1.0));
-                t.push((i + 1, i, -1.0));
-            }
-        }
-        let k = SymmetricCsr::from_triplets(n, &t);
+        let k = crate::fem::sparse::laplacian(n);
         let m = SymmetricCsr::from_triplets(n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
         let pairs = lowest_eigenpairs(&k, &m, 3, 1e-12, 200).unwrap();
         for (i, lambda) in pairs.eigenvalues.iter().enumerate() {

@@ -310,6 +310,21 @@ impl BlockCsr3 {
     }
 }
 
+/// The 1D Laplacian tridiag(−1, 2, −1) of size `n` (SPD; eigenvalues `4 sin²(iπ / (2(n+1)))`):
+/// the known matrix of the solver tests.
+#[cfg(test)]
+pub(crate) fn laplacian(n: usize) -> SymmetricCsr {
+    let mut t = Vec::new();
+    for i in 0..n {
+        t.push((i, i, 2.0));
+        if i + 1 < n {
+            t.push((i, i + 1, -1.0));
+            t.push((i + 1, i, -1.0));
+        }
+    }
+    SymmetricCsr::from_triplets(n, &t)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -247,18 +247,7 @@ impl SparseCholesky {
 mod tests {
     use super::*;
 
-    /// The 1D Laplacian tridiag(−1, 2, −1) of size n (SPD).
-    fn laplacian(n: usize) -> SymmetricCsr {
-        let mut t = Vec::new();
-        for i in 0..n {
-            t.push((i, i, 2.0));
-            if i + 1 < n {
-                t.push((i, i + 1, -1.0));
-                t.push((i + 1, i, -1.0));
-            }
-        }
-        SymmetricCsr::from_triplets(n, &t)
-    }
+    use crate::fem::sparse::laplacian;
 
     #[test]
     fn solves_a_known_system() {

@@ -117,15 +117,7 @@ mod tests {
         // A = tridiag(−1, 2, −1), B = I: (−1 + 2i) I + A has an indefinite real part for the
         // low modes (eigenvalues of A lie in (0, 4)). Residual at round-off.
         let n = 60;
-        let mut t = Vec::new();
-        for i in 0..n {
-            t.push((i, i, 2.0));
-            if i + 1 < n {
-                t.push((i, i + 1, -1.0));
-                t.push((i + 1, i, -1.0));
-            }
-        }
-        let a = SymmetricCsr::from_triplets(n, &t);
+        let a = crate::fem::sparse::laplacian(n);
         let b = SymmetricCsr::from_triplets(n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
         let (ca, cb) = (c64::new(1.0, 0.0), c64::new(-1.0, 2.0));
         let mut lu = ComplexLu::new(ca, &a, cb, &b).unwrap();

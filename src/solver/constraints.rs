@@ -42,6 +42,18 @@ impl PointConstraint {
         }
         c
     }
+
+    /// Row `e` of the constraint on a free-DOF column: `Σ ŵ_i v[row_i + e]` (real or complex).
+    pub fn free_sum<T>(&self, column: &[T], e: usize) -> T
+    where
+        T: Copy + std::ops::Mul<f64, Output = T> + std::iter::Sum<T>,
+    {
+        self.free_rows
+            .iter()
+            .zip(&self.weights)
+            .map(|(&row, &w)| column[row + e] * w)
+            .sum()
+    }
 }
 
 /// The constraint-dependent part of one iteration matrix: `Z = S̄⁻¹ Cᵀ` (free DOFs × 3m,
@@ -80,12 +92,7 @@ impl ConstraintFactor {
             let column = &z[col * n..(col + 1) * n];
             for (q, c) in constraints.iter().enumerate() {
                 for e in 0..3 {
-                    a[(3 * q + e, col)] = c
-                        .free_rows
-                        .iter()
-                        .zip(&c.weights)
-                        .map(|(&row, &w)| w * column[row + e])
-                        .sum();
+                    a[(3 * q + e, col)] = c.free_sum(column, e);
                 }
             }
         }

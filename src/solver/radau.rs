@@ -207,12 +207,7 @@ impl StageConstraints {
             let column = &z[col * n..(col + 1) * n];
             for (q, c) in constraints.iter().enumerate() {
                 for e in 0..3 {
-                    a[(3 * q + e, col)] = c
-                        .free_rows
-                        .iter()
-                        .zip(&c.weights)
-                        .map(|(&row, &w)| column[row + e] * w)
-                        .sum();
+                    a[(3 * q + e, col)] = c.free_sum(column, e);
                 }
             }
         }

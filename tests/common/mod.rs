@@ -5,6 +5,7 @@ pub mod b3;
 
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
+use nalgebra::{Matrix3, Rotation3, Vector3};
 
 /// Timoshenko tip deflection of B1 under 10 N (BENCHMARKS.md), m.
 pub const B1_TIMOSHENKO_DEFLECTION: f64 = 1.19084e-3;
@@ -67,4 +68,42 @@ pub fn b1_settled_deflection() -> f64 {
         fixed.do_step(k as f64 * h, h).unwrap();
     }
     get(&mut fixed, "tip.position[2]") - y0
+}
+
+/// The three components `name[1..3]` as a vector.
+pub fn vector(s: &mut Slave, name: &str) -> Vector3<f64> {
+    Vector3::from_fn(|k, _| get(s, &format!("{name}[{}]", k + 1)))
+}
+
+/// Sets the rotation matrix `name[1..9]` (row-major).
+pub fn set_rotation(s: &mut Slave, name: &str, q: &Matrix3<f64>) {
+    for k in 0..9 {
+        set(s, &format!("{name}[{}]", k + 1), q[(k / 3, k % 3)]);
+    }
+}
+
+/// B4: the root of `s` (motion interface `root`) turned about z at `omega` for 6 s in steps of
+/// `h`, B1's 10 N tip load turning with it. Returns the largest deviation of the tip deflection
+/// in the root frame from B1's clamped static value ([`b1_settled_deflection`]) over the last
+/// 2 s, relative to it (the start-up transient has decayed by then).
+pub fn b4_deviation_from_static(s: &mut Slave, h: f64, omega: f64) -> f64 {
+    let static_deflection = b1_settled_deflection();
+    let mut worst: f64 = 0.0;
+    for k in 0..(6.0 / h).round() as usize {
+        let t = k as f64 * h;
+        let q = *Rotation3::from_axis_angle(&Vector3::z_axis(), omega * t).matrix();
+        set_rotation(s, "root.rotation", &q);
+        let load = q * Vector3::new(0.0, -10.0, 0.0);
+        for c in 0..3 {
+            set(s, &format!("tip.force[{}]", c + 1), load[c]);
+        }
+        s.do_step(t, h).unwrap();
+        if t + h >= 4.0 {
+            let q_end = *Rotation3::from_axis_angle(&Vector3::z_axis(), omega * (t + h)).matrix();
+            let local =
+                q_end.transpose() * (vector(s, "tip.position") - vector(s, "root.position"));
+            worst = worst.max((local.y - static_deflection).abs() / static_deflection.abs());
+        }
+    }
+    worst
 }
