@@ -8,16 +8,10 @@ use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::Vector3;
 
-const PENDULUM: &str = r#"{
-  "name": "pendulum",
-  "mesh": { "beam": { "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" } },
-  "material": { "youngsModulus": 2.1e13, "poissonRatio": 0.3, "density": 7850.0 },
-  "interfaces": [
-    { "name": "pivot", "kind": "pin", "nodes": { "plane": { "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } } },
-    { "name": "tip", "kind": "force", "nodes": { "plane": { "point": [1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } }, "referencePoint": [1.0, 0.0, 0.0] }
-  ],
-  "solver": { "stepSize": 1e-3, "rhoInf": 0.9, "tolerance": 1e-10, "maxIterations": 25 }
-}"#;
+/// The pendulum with generalized-α.
+fn pendulum() -> String {
+    pendulum_json(r#"{ "stepSize": 1e-3, "rhoInf": 0.9, "tolerance": 1e-10, "maxIterations": 25 }"#)
+}
 
 /// A steel-dense beam, 100 times stiffer than steel (nearly rigid), pinned at the centre of its
 /// root face, released 0.05 rad from hanging: period `2π sqrt(I_pivot / (m g d))` with
@@ -27,7 +21,7 @@ const PENDULUM: &str = r#"{
 #[test]
 fn pinned_beam_swings_as_a_physical_pendulum() {
     let (g, theta0) = (9.81, 0.05_f64);
-    let mut s = Slave::from_body(BodyFile::from_json(PENDULUM).unwrap()).unwrap();
+    let mut s = Slave::from_body(BodyFile::from_json(&pendulum()).unwrap()).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();
     s.enter_initialization_mode().unwrap();
     // Gravity at θ₀ from the beam axis: the beam starts 0.05 rad from hanging straight.
@@ -94,7 +88,7 @@ fn pinned_beam_swings_as_a_physical_pendulum() {
 #[test]
 fn hinged_beam_swings_in_its_plane() {
     let (g, g_z, theta0) = (9.81, 3.0, 0.05_f64);
-    let body = PENDULUM.replace(
+    let body = pendulum().replace(
         r#""name": "pivot", "kind": "pin","#,
         r#""name": "pivot", "kind": "hinge", "axis": [0.0, 0.0, 1.0],"#,
     );

@@ -293,16 +293,12 @@ fn radau_discards_a_step_that_does_not_converge() {
     assert_eq!(s.dynamic_state().unwrap(), &before);
 }
 
-const PENDULUM: &str = r#"{
-  "name": "pendulum",
-  "mesh": { "beam": { "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" } },
-  "material": { "youngsModulus": 2.1e13, "poissonRatio": 0.3, "density": 7850.0 },
-  "interfaces": [
-    { "name": "pivot", "kind": "pin", "nodes": { "plane": { "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } } },
-    { "name": "tip", "kind": "force", "nodes": { "plane": { "point": [1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } }, "referencePoint": [1.0, 0.0, 0.0] }
-  ],
-  "solver": { "integrator": "radauIIA", "stepSize": 1e-3, "tolerance": 1e-10, "maxIterations": 25 }
-}"#;
+/// `tests/pin_support.rs`'s pendulum with Radau IIA.
+fn pendulum() -> String {
+    pendulum_json(
+        r#"{ "integrator": "radauIIA", "stepSize": 1e-3, "tolerance": 1e-10, "maxIterations": 25 }"#,
+    )
+}
 
 /// Pins and hinges with Radau: the stage multipliers `Λ_s` join the stage increments, and each
 /// of the two block systems is solved through its constant Schur complement `C S_k⁻¹ Cᵀ` (real
@@ -318,9 +314,9 @@ fn radau_swings_a_pinned_and_a_hinged_pendulum() {
     let (l, a) = (1.0_f64, 0.02_f64);
     let period = 2.0 * std::f64::consts::PI * ((l * l / 3.0 + a * a / 12.0) / (g * l / 2.0)).sqrt();
     for (body, g_z) in [
-        (PENDULUM.to_string(), 0.0),
+        (pendulum(), 0.0),
         (
-            PENDULUM.replace(
+            pendulum().replace(
                 r#""name": "pivot", "kind": "pin","#,
                 r#""name": "pivot", "kind": "hinge", "axis": [0.0, 0.0, 1.0],"#,
             ),
@@ -446,7 +442,7 @@ fn radau_spins_up_b3_like_generalized_alpha() {
 fn radau_order_on_the_pinned_pendulum() {
     let run = |h: f64| {
         let mut s = initialized(
-            flexbody::model::BodyFile::from_json(PENDULUM).unwrap(),
+            flexbody::model::BodyFile::from_json(&pendulum()).unwrap(),
             &[
                 ("gravity[1]", 9.81 * 0.05_f64.cos()),
                 ("gravity[2]", 9.81 * 0.05_f64.sin()),

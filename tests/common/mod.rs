@@ -107,3 +107,21 @@ pub fn b4_deviation_from_static(s: &mut Slave, h: f64, omega: f64) -> f64 {
     }
     worst
 }
+
+/// The pendulum body of the pin tests (B1's section, 1 m, 100× steel's stiffness: nearly rigid,
+/// pinned at the centre of its root face, a force interface at the tip) with `solver`, the body
+/// file's `"solver"` object.
+pub fn pendulum_json(solver: &str) -> String {
+    format!(
+        r#"{{
+  "name": "pendulum",
+  "mesh": {{ "beam": {{ "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" }} }},
+  "material": {{ "youngsModulus": 2.1e13, "poissonRatio": 0.3, "density": 7850.0 }},
+  "interfaces": [
+    {{ "name": "pivot", "kind": "pin", "nodes": {{ "plane": {{ "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] }} }} }},
+    {{ "name": "tip", "kind": "force", "nodes": {{ "plane": {{ "point": [1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] }} }}, "referencePoint": [1.0, 0.0, 0.0] }}
+  ],
+  "solver": {solver}
+}}"#
+    )
+}
