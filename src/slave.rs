@@ -307,6 +307,7 @@ pub struct SlaveState {
     parameters: Parameters,
     inputs: Vec<Inputs>,
     input_derivatives: Vec<InputDerivatives>,
+    input_times: Vec<f64>,
     start_time: f64,
     dynamics: Option<Dynamics>,
     /// Internal steps, fixed-point iterations, retried internal steps.
@@ -352,10 +353,18 @@ pub struct Slave {
     parameters: Parameters,
     inputs: Vec<Inputs>,
     default_inputs: Vec<Inputs>,
-    /// Input derivatives (`fmi2SetRealInputDerivatives`), with respect to the communication
-    /// point: over a step the force inputs are `u(t) = u + u'·τ + u''·τ²/2`, `τ = t − t_c`.
+    /// Input derivatives (`fmi2SetRealInputDerivatives`), with respect to the sample time of
+    /// their interface: the force inputs are `u(t) = u + u'·τ + u''·τ²/2`, `τ = t − t_s`.
     input_derivatives: Vec<InputDerivatives>,
-    /// The driving frames of motion interfaces during the current step.
+    /// Per interface, the sample time `t_s` of its inputs: the FMU time at which they were last
+    /// set (the start time before initialization). The inputs describe the interface at `t_s`
+    /// and are extrapolated from there, however many steps the importer takes before it sets
+    /// them again (see [`Slave::resample_inputs`]).
+    input_times: Vec<f64>,
+    /// Per interface, `t_0 − t_s` for the step under way (`t_0` its start): how far the
+    /// inputs' extrapolation has run when the step begins. Scratch, sized once.
+    input_ages: Vec<f64>,
+    /// The driving frames of motion interfaces at the start of the current step.
     driving: Vec<DrivingFrame>,
     start_time: f64,
     model: Option<Model>,
@@ -491,6 +500,8 @@ impl Slave {
             inputs: default_inputs.clone(),
             default_inputs,
             input_derivatives: vec![[[0.0; 30]; 2]; n_interfaces],
+            input_times: vec![0.0; n_interfaces],
+            input_ages: vec![0.0; n_interfaces],
             driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
@@ -590,12 +601,15 @@ impl Slave {
         }
         let _ = tolerance; // the body's own solver.tolerance governs the iteration
         self.start_time = start_time;
+        // Inputs set before the experiment is set up describe the start.
+        self.input_times.fill(start_time);
         Ok(())
     }
 
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
         self.dynamics = None;
+        self.input_times.fill(self.start_time);
         self.outputs.valid = false;
         Ok(())
     }
@@ -767,6 +781,7 @@ impl Slave {
             *d = [[0.0; 30]; 2];
         }
         self.start_time = 0.0;
+        self.input_times.fill(0.0);
         self.dynamics = None;
         self.backup = None;
         self.statistics = (0, 0);
@@ -781,6 +796,7 @@ impl Slave {
             parameters: self.parameters.clone(),
             inputs: self.inputs.clone(),
             input_derivatives: self.input_derivatives.clone(),
+            input_times: self.input_times.clone(),
             start_time: self.start_time,
             dynamics: self.dynamics.clone(),
             counters: [self.statistics.0, self.statistics.1, self.retries],
@@ -791,12 +807,14 @@ impl Slave {
     pub fn set_state(&mut self, state: &SlaveState) -> Result<()> {
         if state.inputs.len() != self.inputs.len()
             || state.input_derivatives.len() != self.inputs.len()
+            || state.input_times.len() != self.inputs.len()
         {
             return Err(Error::new("the FMU state belongs to another body"));
         }
         self.parameters = state.parameters.clone();
         self.inputs.clone_from(&state.inputs);
         self.input_derivatives.clone_from(&state.input_derivatives);
+        self.input_times.clone_from(&state.input_times);
         self.start_time = state.start_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];
@@ -945,6 +963,7 @@ impl Slave {
                         v.name
                     )));
                 }
+                self.resample_inputs(index);
                 self.inputs[index][quantity.slot() as usize + component] = value;
             }
         }
@@ -1123,6 +1142,7 @@ impl Slave {
         }
         for ((&vr, &order), &value) in vrs.iter().zip(orders).zip(values) {
             let (index, order, slot) = self.input_derivative_slot(vr, order, value)?;
+            self.resample_inputs(index);
             self.input_derivatives[index][order][slot] = value;
         }
         Ok(())
@@ -1381,8 +1401,13 @@ impl Slave {
                 dynamics.state.time = current_communication_point + big_h;
                 // The end state's accelerations belong to the inputs extrapolated to t_c + H.
                 dynamics.loads.clone_from(&self.inputs);
-                for (load, d) in dynamics.loads.iter_mut().zip(&self.input_derivatives) {
-                    extrapolate(load, d, big_h);
+                for ((load, d), age) in dynamics
+                    .loads
+                    .iter_mut()
+                    .zip(&self.input_derivatives)
+                    .zip(&self.input_ages)
+                {
+                    extrapolate(load, d, age + big_h);
                 }
                 dynamics.gravity = self.parameters.gravity;
                 self.outputs.valid = false;
@@ -1513,6 +1538,7 @@ impl Slave {
         let interfaces = &self.interfaces;
         let inputs = &self.inputs;
         let derivatives = &self.input_derivatives;
+        let ages = &self.input_ages;
         let tau = std::cell::Cell::new(tau0);
         let body = &model.body;
         let loads = |x: &[f64], f: &mut [f64]| {
@@ -1520,7 +1546,7 @@ impl Slave {
                 body,
                 interfaces,
                 inputs,
-                Some((derivatives, tau.get())),
+                Some((derivatives, ages, tau.get())),
                 &gravity,
                 x,
                 f,
@@ -1581,16 +1607,69 @@ impl Slave {
         Ok(())
     }
 
-    /// The driving frames of the motion interfaces from the current inputs (no allocation unless
-    /// an input is rejected).
+    /// The inputs' ages at the current time `t_0` (`t_0 − t_s` per interface) and the driving
+    /// frames of the motion interfaces there: the frame of the inputs, extrapolated from their
+    /// sample time `t_s` to `t_0` (no allocation unless an input is rejected).
     fn update_driving_frames(&mut self) -> Result<()> {
+        let t = self.time();
         for (k, interface) in self.interfaces.iter().enumerate() {
+            let age = t - self.input_times[k];
+            self.input_ages[k] = age;
             if interface.kind == InterfaceKind::Motion {
-                self.driving[k] =
-                    driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
+                let mut frame = driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
+                if age != 0.0 {
+                    (frame.position, frame.rotation) = frame.at(age);
+                }
+                self.driving[k] = frame;
             }
         }
         Ok(())
+    }
+
+    /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or
+    /// a derivative) is set. Inputs set at time `t_s` describe the interface at `t_s`; those
+    /// not set again continue along their extrapolation, so they are moved to the current time
+    /// `t` (`τ = t − t_s`): a motion interface's pose with its velocities (`p + v τ`,
+    /// `exp([ω]× τ) Q`), a force interface's force and torque with their derivatives
+    /// (`u + u'τ + u''τ²/2`, `u' + u''τ`). Before initialization the inputs describe the start
+    /// time. Allocation-free.
+    fn resample_inputs(&mut self, k: usize) {
+        let t = self.time();
+        let tau = t - self.input_times[k];
+        self.input_times[k] = t;
+        if self.dynamics.is_none() || tau == 0.0 {
+            return;
+        }
+        let input = &mut self.inputs[k];
+        match self.interfaces[k].kind {
+            InterfaceKind::Motion => {
+                let slot = |q: InterfaceQuantity| q.slot() as usize;
+                let vector = |input: &Inputs, q: InterfaceQuantity| {
+                    Vector3::from_column_slice(&input[slot(q)..slot(q) + 3])
+                };
+                let r = slot(InterfaceQuantity::Rotation);
+                let frame = DrivingFrame {
+                    position: vector(input, InterfaceQuantity::Position),
+                    rotation: Matrix3::from_row_slice(&input[r..r + 9]),
+                    velocity: vector(input, InterfaceQuantity::Velocity),
+                    angular_velocity: vector(input, InterfaceQuantity::AngularVelocity),
+                };
+                let (p, q) = frame.at(tau);
+                let at = slot(InterfaceQuantity::Position);
+                input[at..at + 3].copy_from_slice(p.as_slice());
+                for (j, value) in input[r..r + 9].iter_mut().enumerate() {
+                    *value = q[(j / 3, j % 3)];
+                }
+            }
+            InterfaceKind::Force => {
+                let d = &mut self.input_derivatives[k];
+                extrapolate(input, d, tau);
+                for s in 0..6 {
+                    d[0][s] += d[1][s] * tau;
+                }
+            }
+            InterfaceKind::Fixed | InterfaceKind::Pin | InterfaceKind::Hinge => {}
+        }
     }
 
     /// Builds the model if the parameters it depends on changed (assembly and frames).
@@ -2556,14 +2635,14 @@ fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
 }
 
 /// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
-/// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
-/// torque distributed over its node set; added to `f`. With `extrapolation = (derivatives, τ)`
-/// the force inputs are taken `τ` seconds after the communication point (see [`extrapolate`]).
+/// torque distributed over its node set; added to `f`. With `extrapolation = (derivatives,
+/// ages, τ)` the force inputs are taken `τ` seconds after the start of the step, which is
+/// `ages[k]` after interface `k`'s inputs were sampled (see [`extrapolate`]).
 fn apply_loads(
     body: &Body,
     interfaces: &[Interface],
     inputs: &[Inputs],
-    extrapolation: Option<(&[InputDerivatives], f64)>,
+    extrapolation: Option<(&[InputDerivatives], &[f64], f64)>,
     gravity: &Vector3<f64>,
     x: &[f64],
     f: &mut [f64],
@@ -2577,8 +2656,9 @@ fn apply_loads(
         }
         let mut load = [0.0; 6];
         load.copy_from_slice(&input[..6]);
-        if let Some((derivatives, tau)) = extrapolation {
+        if let Some((derivatives, ages, tau)) = extrapolation {
             let d = &derivatives[k];
+            let tau = ages[k] + tau;
             for (s, value) in load.iter_mut().enumerate() {
                 if d[0][s] != 0.0 || d[1][s] != 0.0 {
                     *value += d[0][s] * tau + 0.5 * d[1][s] * tau * tau;
@@ -2593,7 +2673,7 @@ fn apply_loads(
     }
 }
 
-/// A force interface's inputs `τ` seconds after the communication point: `u + u'·τ + u''·τ²/2`
+/// A force interface's inputs `τ` seconds after their sample time: `u + u'·τ + u''·τ²/2`
 /// in the force and torque slots (the only ones with derivatives); the same arithmetic as
 /// [`apply_loads`], so the end-of-step loads match those the last internal step used.
 fn extrapolate(input: &mut Inputs, d: &InputDerivatives, tau: f64) {

@@ -10,6 +10,7 @@
 //! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces, auto: u8 |
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
+//! | input sample times | `n` f64 (the time each interface's inputs describe) |
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries: u64 |
 //! | dynamics present | u8 (0 before initialization) |
@@ -26,7 +27,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::generalized_alpha::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 2;
+pub const PAYLOAD_FORMAT: u32 = 3;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -145,6 +146,7 @@ impl SlaveState {
             w.f64s(&d[0]);
             w.f64s(&d[1]);
         }
+        w.f64s(&self.input_times);
         w.f64(self.start_time);
         self.counters.iter().for_each(|&c| w.u64(c));
         match &self.dynamics {
@@ -240,6 +242,8 @@ impl Slave {
             r.f64s(&mut d[0], "an input derivative")?;
             r.f64s(&mut d[1], "an input derivative")?;
         }
+        let mut input_times = vec![0.0; n];
+        r.f64s(&mut input_times, "an input sample time")?;
         let start_time = r.f64("the start time")?;
         let counters = [
             r.u64("the step counter")?,
@@ -338,6 +342,7 @@ impl Slave {
             parameters: p,
             inputs,
             input_derivatives,
+            input_times,
             start_time,
             dynamics,
             counters,

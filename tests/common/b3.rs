@@ -50,19 +50,38 @@ impl HubDrive {
         t: f64,
         h: f64,
     ) -> flexbody::error::Result<f64> {
+        self.set_hub(slave, t)?;
+        slave.do_step(t, h)?;
+        self.tip_deflection(slave, t + h)
+    }
+
+    /// Sets the hub inputs (rotation and rate) of the schedule at `t`.
+    pub fn set_hub(
+        &self,
+        slave: &mut flexbody::slave::Slave,
+        t: f64,
+    ) -> flexbody::error::Result<()> {
         use nalgebra::{Rotation3, Vector3};
         let (theta, rate) = hub(t);
         let q = Rotation3::from_axis_angle(&Vector3::z_axis(), theta);
         for (c, &r) in self.rotation.iter().enumerate() {
             slave.set_real(r, q.matrix()[(c / 3, c % 3)])?;
         }
-        slave.set_real(self.rate, rate)?;
-        slave.do_step(t, h)?;
+        slave.set_real(self.rate, rate)
+    }
+
+    /// The tip deflection in the hub frame of the schedule at `t` (m), `t` the slave's time.
+    pub fn tip_deflection(
+        &self,
+        slave: &mut flexbody::slave::Slave,
+        t: f64,
+    ) -> flexbody::error::Result<f64> {
+        use nalgebra::{Rotation3, Vector3};
         let mut p = Vector3::zeros();
         for (c, &r) in self.tip.iter().enumerate() {
             p[c] = slave.get_real(r)?;
         }
-        let back = Rotation3::from_axis_angle(&Vector3::z_axis(), hub(t + h).0).inverse();
+        let back = Rotation3::from_axis_angle(&Vector3::z_axis(), hub(t).0).inverse();
         Ok((back * p).y)
     }
 }
