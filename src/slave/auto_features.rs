@@ -1,0 +1,96 @@
+//! `model.auto`: which of the allowed terms are in force, chosen per communication step.
+
+use super::assembly::Model;
+use super::{Dynamics, LogEvent};
+use crate::body::feature_indicators::{self};
+
+/// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
+/// finite number: the state's byte form holds finite numbers only).
+pub(super) const NOT_QUIET: f64 = f64::MAX;
+
+/// `model.auto`: decides from the state at the communication point which allowed terms are in
+/// force over the next communication step (held over its internal steps, like `K_G`), logs each
+/// change once under `logEvents` with the estimate and the threshold, and puts the terms into
+/// force. A term goes on when `SAFETY × estimate > target`; it goes off when that has stayed
+/// below `HYSTERESIS × target` for one period `2π/ω₁` of the lowest mode (a vibrating body's
+/// indicators peak twice per period: the dwell keeps a term from switching with the vibration). `target` is the iteration's absolute tolerance `solver.tolerance × size` (m). No
+/// allocation unless a decision changes.
+pub(super) fn choose_features(
+    model: &mut Model,
+    dynamics: &mut Dynamics,
+    target: f64,
+    events: &mut Vec<LogEvent>,
+) {
+    if let Some(indicators) = model.indicators.as_mut() {
+        let s = &dynamics.state;
+        let e = indicators.estimate(&model.body, &s.position, &s.velocity, &s.acceleration);
+        let dwell = indicators
+            .first_frequency()
+            .map_or(0.0, |w| 2.0 * std::f64::consts::PI / w);
+        let mut f = dynamics.features;
+        let mut decide = |active: &mut bool,
+                          quiet_since: &mut f64,
+                          allowed: bool,
+                          estimate: Option<f64>,
+                          name: &str| {
+            let Some(e) = estimate.filter(|_| allowed) else {
+                *active = allowed;
+                *quiet_since = NOT_QUIET;
+                return;
+            };
+            let scaled = feature_indicators::SAFETY * e;
+            let next = if *active {
+                if scaled >= feature_indicators::HYSTERESIS * target {
+                    *quiet_since = NOT_QUIET;
+                    true
+                } else {
+                    if *quiet_since == NOT_QUIET {
+                        *quiet_since = s.time;
+                    }
+                    s.time - *quiet_since < dwell
+                }
+            } else {
+                scaled > target
+            };
+            if next != *active {
+                *active = next;
+                events.push(LogEvent {
+                    category: "logEvents",
+                    message: if next {
+                        format!(
+                            "model.auto: at t = {} {name} switched on: estimated effect {e:.3e} m, × {} = {scaled:.3e} m > solver.tolerance × size = {target:.3e} m",
+                            s.time,
+                            feature_indicators::SAFETY
+                        )
+                    } else {
+                        format!(
+                            "model.auto: at t = {} {name} switched off: estimated effect {e:.3e} m, × {} = {scaled:.3e} m < {} × solver.tolerance × size = {:.3e} m since t = {} (at least one period 2π/ω₁ = {dwell:.3e} s)",
+                            s.time,
+                            feature_indicators::SAFETY,
+                            feature_indicators::HYSTERESIS,
+                            feature_indicators::HYSTERESIS * target,
+                            *quiet_since
+                        )
+                    },
+                });
+            }
+        };
+        let [quiet_nl, quiet_stiffening] = &mut dynamics.quiet_since;
+        decide(
+            &mut f.nonlinear_forces,
+            quiet_nl,
+            model.allowed.nonlinear_forces,
+            e.nonlinear_forces,
+            "the nonlinear force f_nl",
+        );
+        decide(
+            &mut f.stiffening,
+            quiet_stiffening,
+            model.allowed.stiffening,
+            e.stiffening,
+            "geometric stiffening",
+        );
+        dynamics.features = f;
+    }
+    model.apply_features(dynamics.features);
+}

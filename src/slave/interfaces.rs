@@ -1,0 +1,271 @@
+//! Interfaces at run time: their node sets and point constraints, the driving frames of motion
+//! interfaces, the loads of force interfaces, and the inputs as samples in time.
+
+use super::{InputDerivatives, Inputs, Slave};
+use crate::body::frame::{nearest_rotation, node};
+use crate::body::interface::DrivingFrame;
+use crate::body::{Body, NodeSet};
+use crate::error::{Error, Result};
+use crate::model::variables::InterfaceQuantity;
+use crate::model::InterfaceKind;
+use crate::solver::generalized_alpha::DynamicState;
+use nalgebra::{Matrix3, Vector3};
+
+/// An interface at run time: its kind and node set.
+#[derive(Debug, Clone)]
+pub(super) struct Interface {
+    pub(super) kind: InterfaceKind,
+    pub(super) set: NodeSet,
+    /// Point constraints of a pin (one: the whole set) or a hinge (two: the halves of the set
+    /// on either side of the plane through its centroid normal to the axis): node lists and
+    /// weights.
+    pub(super) point_constraints: Vec<(Vec<usize>, Vec<f64>)>,
+    /// Index of the first of them in the solver's constraint list.
+    pub(super) first_constraint: usize,
+}
+
+/// The point constraints of a pin (the whole set) or a hinge (the two halves of the set on either
+/// side of the plane through its centroid normal to `axis`; both halves' centroids must lie on
+/// the axis, so that turning about it moves neither: a hole or a face with the axis through its
+/// centre). Holding both half-centroids leaves exactly the rotation about the axis free.
+pub(super) fn point_constraints(
+    spec: &crate::model::InterfaceSpec,
+    nodes: &[usize],
+    weights: &[f64],
+    reference: &[f64],
+    size: f64,
+) -> Result<Vec<(Vec<usize>, Vec<f64>)>> {
+    let total: f64 = weights.iter().sum();
+    let centroid = nodes
+        .iter()
+        .zip(weights)
+        .fold(Vector3::zeros(), |c, (&i, w)| {
+            c + *w / total * node(reference, i)
+        });
+    let tolerance = 1e-9 * size;
+    if matches!(spec.kind, InterfaceKind::Pin | InterfaceKind::Hinge) {
+        if let Some(p) = spec.reference_point {
+            if (Vector3::from(p) - centroid).norm() > tolerance {
+                return Err(Error::new(format!(
+                    "interface '{}': a {:?} acts at the weighted centroid {:?} of its node set; referencePoint {:?} must be omitted or equal to it",
+                    spec.name,
+                    spec.kind,
+                    centroid.as_slice(),
+                    p
+                )));
+            }
+        }
+    }
+    match spec.kind {
+        InterfaceKind::Pin => Ok(vec![(nodes.to_vec(), weights.to_vec())]),
+        InterfaceKind::Hinge => {
+            let axis = spec.axis.map(Vector3::from).unwrap_or_default();
+            if axis.norm().is_nan() || axis.norm() <= 0.0 {
+                return Err(Error::new(format!(
+                    "interface '{}': a hinge needs a nonzero \"axis\"",
+                    spec.name
+                )));
+            }
+            let axis = axis.normalize();
+            let mut halves = [(Vec::new(), Vec::new()), (Vec::new(), Vec::new())];
+            for (&i, &w) in nodes.iter().zip(weights) {
+                let s = (node(reference, i) - centroid).dot(&axis);
+                if s.abs() > tolerance {
+                    let half = &mut halves[usize::from(s > 0.0)];
+                    half.0.push(i);
+                    half.1.push(w);
+                }
+            }
+            for (nodes, weights) in &halves {
+                let total: f64 = weights.iter().sum();
+                if nodes.is_empty() {
+                    return Err(Error::new(format!(
+                        "interface '{}': the node set does not extend along the hinge axis {:?}",
+                        spec.name,
+                        axis.as_slice()
+                    )));
+                }
+                let c = nodes
+                    .iter()
+                    .zip(weights)
+                    .fold(Vector3::zeros(), |c, (&i, w)| {
+                        c + *w / total * node(reference, i)
+                    });
+                let off_axis = (c - centroid).cross(&axis).norm();
+                if off_axis > 1e-6 * size {
+                    return Err(Error::new(format!(
+                        "interface '{}': the hinge axis {:?} through the centroid {:?} misses the centroid of one half of the node set by {off_axis:.3e} m; choose a set symmetric about the axis (a hole, or a face with the axis through its centre)",
+                        spec.name,
+                        axis.as_slice(),
+                        centroid.as_slice()
+                    )));
+                }
+            }
+            Ok(halves.into_iter().collect())
+        }
+        _ => Ok(Vec::new()),
+    }
+}
+
+/// The driving frame of motion interface `name` from its inputs: a rotation input within 1e-3 of
+/// orthonormal is orthonormalised (nearest rotation), one further off is an error.
+pub(super) fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
+    let slot = |q: InterfaceQuantity| q.slot() as usize;
+    let vector = |q: InterfaceQuantity| Vector3::from_column_slice(&values[slot(q)..slot(q) + 3]);
+    let r = slot(InterfaceQuantity::Rotation);
+    let q = Matrix3::from_row_slice(&values[r..r + 9]);
+    let deviation = (q.transpose() * q - Matrix3::identity()).amax();
+    if deviation > 1e-3 || q.determinant() <= 0.0 {
+        return Err(Error::new(format!(
+            "{name}.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); inputs within 1e-3 of orthonormal are orthonormalised",
+            &values[r..r + 9],
+            q.determinant()
+        )));
+    }
+    Ok(DrivingFrame {
+        position: vector(InterfaceQuantity::Position),
+        rotation: nearest_rotation(&q),
+        velocity: vector(InterfaceQuantity::Velocity),
+        angular_velocity: vector(InterfaceQuantity::AngularVelocity),
+    })
+}
+
+/// Clamps the nodes of every motion interface to its driving frame `tau` seconds into the step.
+pub(super) fn prescribe_motion(
+    body: &Body,
+    interfaces: &[Interface],
+    driving: &[DrivingFrame],
+    tau: f64,
+    state: &mut DynamicState,
+) {
+    for (interface, frame) in interfaces.iter().zip(driving) {
+        if interface.kind == InterfaceKind::Motion {
+            interface.set.prescribe(
+                &body.reference,
+                frame,
+                tau,
+                &mut state.position,
+                &mut state.velocity,
+                &mut state.acceleration,
+            );
+        }
+    }
+}
+
+/// External loads at positions `x`: gravity `M (1 ⊗ g)` and each force interface's force and
+/// torque distributed over its node set; added to `f`. With `extrapolation = (derivatives,
+/// ages, τ)` the force inputs are taken `τ` seconds after the start of the step, which is
+/// `ages[k]` after interface `k`'s inputs were sampled (see [`extrapolate`]).
+pub(super) fn apply_loads(
+    body: &Body,
+    interfaces: &[Interface],
+    inputs: &[Inputs],
+    extrapolation: Option<(&[InputDerivatives], &[f64], f64)>,
+    gravity: &Vector3<f64>,
+    x: &[f64],
+    f: &mut [f64],
+) {
+    if gravity.norm_squared() > 0.0 {
+        body.add_uniform_acceleration_load(gravity, f);
+    }
+    for (k, (interface, input)) in interfaces.iter().zip(inputs).enumerate() {
+        if interface.kind != InterfaceKind::Force {
+            continue;
+        }
+        let mut load = [0.0; 6];
+        load.copy_from_slice(&input[..6]);
+        if let Some((derivatives, ages, tau)) = extrapolation {
+            let d = &derivatives[k];
+            let tau = ages[k] + tau;
+            for (s, value) in load.iter_mut().enumerate() {
+                if d[0][s] != 0.0 || d[1][s] != 0.0 {
+                    *value += d[0][s] * tau + 0.5 * d[1][s] * tau * tau;
+                }
+            }
+        }
+        if load.iter().any(|&v| v != 0.0) {
+            let force = Vector3::new(load[0], load[1], load[2]);
+            let torque = Vector3::new(load[3], load[4], load[5]);
+            interface.set.distribute(x, &force, &torque, f);
+        }
+    }
+}
+
+/// A force interface's inputs `τ` seconds after their sample time: `u + u'·τ + u''·τ²/2`
+/// in the force and torque slots (the only ones with derivatives); the same arithmetic as
+/// [`apply_loads`], so the end-of-step loads match those the last internal step used.
+pub(super) fn extrapolate(input: &mut Inputs, d: &InputDerivatives, tau: f64) {
+    for s in 0..6 {
+        if d[0][s] != 0.0 || d[1][s] != 0.0 {
+            input[s] += d[0][s] * tau + 0.5 * d[1][s] * tau * tau;
+        }
+    }
+}
+
+impl Slave {
+    /// The inputs' ages at the current time `t_0` (`t_0 − t_s` per interface) and the driving
+    /// frames of the motion interfaces there: the frame of the inputs, extrapolated from their
+    /// sample time `t_s` to `t_0` (no allocation unless an input is rejected).
+    pub(super) fn update_driving_frames(&mut self) -> Result<()> {
+        let t = self.time();
+        for (k, interface) in self.interfaces.iter().enumerate() {
+            let age = t - self.input_times[k];
+            self.input_ages[k] = age;
+            if interface.kind == InterfaceKind::Motion {
+                let mut frame = driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
+                if age != 0.0 {
+                    (frame.position, frame.rotation) = frame.at(age);
+                }
+                self.driving[k] = frame;
+            }
+        }
+        Ok(())
+    }
+
+    /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or
+    /// a derivative) is set. Inputs set at time `t_s` describe the interface at `t_s`; those
+    /// not set again continue along their extrapolation, so they are moved to the current time
+    /// `t` (`τ = t − t_s`): a motion interface's pose with its velocities (`p + v τ`,
+    /// `exp([ω]× τ) Q`), a force interface's force and torque with their derivatives
+    /// (`u + u'τ + u''τ²/2`, `u' + u''τ`). Before initialization the inputs describe the start
+    /// time. Allocation-free.
+    pub(super) fn resample_inputs(&mut self, k: usize) {
+        let t = self.time();
+        let tau = t - self.input_times[k];
+        self.input_times[k] = t;
+        if self.dynamics.is_none() || tau == 0.0 {
+            return;
+        }
+        let input = &mut self.inputs[k];
+        match self.interfaces[k].kind {
+            InterfaceKind::Motion => {
+                let slot = |q: InterfaceQuantity| q.slot() as usize;
+                let vector = |input: &Inputs, q: InterfaceQuantity| {
+                    Vector3::from_column_slice(&input[slot(q)..slot(q) + 3])
+                };
+                let r = slot(InterfaceQuantity::Rotation);
+                let frame = DrivingFrame {
+                    position: vector(input, InterfaceQuantity::Position),
+                    rotation: Matrix3::from_row_slice(&input[r..r + 9]),
+                    velocity: vector(input, InterfaceQuantity::Velocity),
+                    angular_velocity: vector(input, InterfaceQuantity::AngularVelocity),
+                };
+                let (p, q) = frame.at(tau);
+                let at = slot(InterfaceQuantity::Position);
+                input[at..at + 3].copy_from_slice(p.as_slice());
+                for (j, value) in input[r..r + 9].iter_mut().enumerate() {
+                    *value = q[(j / 3, j % 3)];
+                }
+            }
+            InterfaceKind::Force => {
+                let d = &mut self.input_derivatives[k];
+                extrapolate(input, d, tau);
+                let [first, second] = d;
+                for (rate, change) in first[..6].iter_mut().zip(&second[..6]) {
+                    *rate += change * tau;
+                }
+            }
+            InterfaceKind::Fixed | InterfaceKind::Pin | InterfaceKind::Hinge => {}
+        }
+    }
+}

@@ -1,0 +1,539 @@
+//! One co-simulation instance: parameters and inputs → body → solver → outputs; `do_step`; state
+//! save and restore. Knows nothing of C pointers: the FMI glue in `fmi2` calls it after checking
+//! arguments and the calling sequence.
+
+use crate::body::interface::DrivingFrame;
+use crate::body::{Body, NodeSet};
+use crate::error::{Error, Result};
+use crate::fem::{self};
+use crate::mesh::Mesh;
+use crate::model::model_description::{model_description, ModelInfo};
+use crate::model::variables::{InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
+use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
+use crate::output::ResultWriter;
+use crate::solver::generalized_alpha::{DynamicState, FreeNodes, IterationMatrix};
+use assembly::Model;
+use interfaces::{point_constraints, Interface};
+use nalgebra::Vector3;
+use outputs::Outputs;
+use parameters::read_parameter;
+use results::file_stem;
+use std::path::Path;
+use variables::component_of;
+
+mod assembly;
+mod auto_features;
+mod initial_state;
+mod interfaces;
+mod outputs;
+mod parameters;
+mod results;
+mod state_bytes;
+mod stepping;
+mod variables;
+pub use assembly::{Features, MATRIX_CACHE_SIZE};
+pub use parameters::Parameters;
+pub use state_bytes::PAYLOAD_FORMAT as STATE_PAYLOAD_FORMAT;
+pub use stepping::MAX_STEP_HALVINGS;
+
+/// The input values of one interface, indexed by value-reference slot
+/// ([`InterfaceQuantity::slot`]).
+type Inputs = [f64; 30];
+
+/// The first and second time derivatives of one interface's inputs (`fmi2SetRealInputDerivatives`;
+/// only the force and torque slots of force interfaces are ever non-zero).
+type InputDerivatives = [Inputs; 2];
+
+/// Highest order of `fmi2SetRealInputDerivatives` (force inputs are extrapolated by their Taylor
+/// polynomial of this degree).
+pub const MAX_INPUT_DERIVATIVE_ORDER: i32 = 2;
+
+/// `maxOutputDerivativeOrder`: see [`Slave::get_real_output_derivative`].
+pub const MAX_OUTPUT_DERIVATIVE_ORDER: i32 = 2;
+
+/// The motion state and the loads it is in equilibrium with.
+#[derive(Debug, Clone, PartialEq)]
+struct Dynamics {
+    state: DynamicState,
+    /// Inputs per interface that `state`'s accelerations belong to.
+    loads: Vec<Inputs>,
+    gravity: [f64; 3],
+    /// The terms in force.
+    features: Features,
+    /// Per term (f_nl, stiffening): since when its estimate has stayed below the switch-off
+    /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
+    quiet_since: [f64; 2],
+}
+
+/// A snapshot of everything that determines later steps (time, positions, velocities,
+/// accelerations, inputs and their derivatives, parameters) and the step counters. Restoring it
+/// reproduces later steps bit for bit. [`SlaveState::to_bytes`] / [`Slave::state_from_bytes`]
+/// give it a portable byte form (module `state_bytes`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlaveState {
+    parameters: Parameters,
+    inputs: Vec<Inputs>,
+    input_derivatives: Vec<InputDerivatives>,
+    input_times: Vec<f64>,
+    start_time: f64,
+    dynamics: Option<Dynamics>,
+    /// Internal steps, fixed-point iterations, retried internal steps.
+    counters: [u64; 3],
+}
+
+/// A message for the importer's logger that is not an error: `category` is one of the declared
+/// log categories (`logEvents`, `logSolver`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogEvent {
+    pub category: &'static str,
+    pub message: String,
+}
+
+/// One instance of the flexible body.
+pub struct Slave {
+    body_file: BodyFile,
+    variables: VariableTable,
+    guid: String,
+    mesh: Mesh,
+    /// Node sets, and `clamped[i]` for nodes held by a `fixed` support.
+    interfaces: Vec<Interface>,
+    clamped: Vec<bool>,
+    /// The material region of each element (`BodyFile::regions`), `None`: `material.*`.
+    element_regions: Vec<Option<usize>>,
+    /// Characteristic size of the body (m): the diagonal of its bounding box.
+    size: f64,
+    defaults: Parameters,
+    parameters: Parameters,
+    inputs: Vec<Inputs>,
+    default_inputs: Vec<Inputs>,
+    /// Input derivatives (`fmi2SetRealInputDerivatives`), with respect to the sample time of
+    /// their interface: the force inputs are `u(t) = u + u'·τ + u''·τ²/2`, `τ = t − t_s`.
+    input_derivatives: Vec<InputDerivatives>,
+    /// Per interface, the sample time `t_s` of its inputs: the FMU time at which they were last
+    /// set (the start time before initialization). The inputs describe the interface at `t_s`
+    /// and are extrapolated from there, however many steps the importer takes before it sets
+    /// them again (see [`Slave::resample_inputs`]).
+    input_times: Vec<f64>,
+    /// Per interface, `t_0 − t_s` for the step under way (`t_0` its start): how far the
+    /// inputs' extrapolation has run when the step begins. Scratch, sized once.
+    input_ages: Vec<f64>,
+    /// The driving frames of motion interfaces at the start of the current step.
+    driving: Vec<DrivingFrame>,
+    start_time: f64,
+    model: Option<Model>,
+    dynamics: Option<Dynamics>,
+    /// Backup of the dynamics at the start of a communication step (rollback on failure).
+    backup: Option<DynamicState>,
+    /// Backup at the start of an internal step being retried with smaller steps.
+    retry_backup: Option<DynamicState>,
+    outputs: Outputs,
+    /// Internal steps and fixed-point iterations since initialization.
+    statistics: (u64, u64),
+    /// Internal steps that did not converge and were retried with halved steps.
+    retries: u64,
+    /// Messages for the logger, drained by the FMI layer after each call.
+    events: Vec<LogEvent>,
+    /// The VTK results of this run, if `output.directory` is set.
+    results: Option<ResultWriter>,
+}
+
+impl Slave {
+    /// Loads `body.json` from the resource directory if there is one, else the embedded default body.
+    pub fn from_resources(resource_dir: Option<&Path>) -> Result<Slave> {
+        let body = match resource_dir.map(|d| d.join("body.json")) {
+            Some(path) if path.exists() => {
+                let text = std::fs::read_to_string(&path).map_err(|e| {
+                    Error::new(format!("cannot read the body file {}: {e}", path.display()))
+                })?;
+                BodyFile::from_json(&text)
+                    .map_err(|e| Error::new(format!("{}: {}", path.display(), e.message)))?
+            }
+            _ => BodyFile::default_body(),
+        };
+        Slave::from_body_in(body, resource_dir)
+    }
+
+    /// Reads the body file at `path` (a mesh file it names is looked up beside it).
+    pub fn from_body_path(path: &Path) -> Result<Slave> {
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Error::new(format!("cannot read the body file {}: {e}", path.display()))
+        })?;
+        let body = BodyFile::from_json(&text)
+            .map_err(|e| Error::new(format!("{}: {}", path.display(), e.message)))?;
+        Slave::from_body_in(body, path.parent())
+    }
+
+    /// A fresh instance of `body_file` (parameters at their start values, Instantiated); a mesh
+    /// file it names is looked up relative to the current directory.
+    pub fn from_body(body_file: BodyFile) -> Result<Slave> {
+        Slave::from_body_in(body_file, None)
+    }
+
+    /// [`Slave::from_body`] with mesh files looked up in `base_dir` (the body file's directory).
+    pub fn from_body_in(body_file: BodyFile, base_dir: Option<&Path>) -> Result<Slave> {
+        body_file.check()?;
+        let mesh = body_file.mesh.build(base_dir)?;
+        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+        let lumped = fem::lumped_masses(&mesh, 1.0);
+        let mut interfaces = Vec::new();
+        let mut clamped = vec![false; mesh.node_count()];
+        let (lo, hi) = mesh.bounding_box();
+        let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
+        for spec in &body_file.interfaces {
+            let nodes = spec
+                .nodes
+                .select(&mesh)
+                .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
+            let weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
+            if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
+                for &i in &nodes {
+                    clamped[i] = true;
+                }
+            }
+            let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
+            let set = NodeSet::new(
+                &spec.name,
+                nodes,
+                weights,
+                &reference,
+                spec.reference_point.map(Vector3::from),
+            )?;
+            interfaces.push(Interface {
+                kind: spec.kind,
+                set,
+                point_constraints,
+                first_constraint: 0,
+            });
+        }
+        if clamped.iter().all(|&c| c) {
+            return Err(Error::new(
+                "body file: fixed supports hold every node: nothing can move",
+            ));
+        }
+        let variables = VariableTable::new(&body_file.interfaces);
+        let defaults = Parameters::from_body_file(&body_file);
+        for v in variables.iter() {
+            if let (Target::Fixed { key, .. }, VariableType::Real) = (v.target, v.ty) {
+                let value = read_parameter(&defaults, key, component_of(v));
+                if let Some(value) = value {
+                    Parameters::check_real(&v.name, key, value)
+                        .map_err(|e| Error::new(format!("body file: {}", e.message)))?;
+                }
+            }
+        }
+        let element_regions = body_file.element_regions(&mesh)?;
+        let guid = guid_of(&body_file);
+        let n_interfaces = interfaces.len();
+        // Motion interfaces start at their place in the body file, at rest.
+        let default_inputs: Vec<Inputs> = interfaces
+            .iter()
+            .map(|i| {
+                let mut values = [0.0; 30];
+                if i.kind == InterfaceKind::Motion {
+                    let p = InterfaceQuantity::Position.slot() as usize;
+                    values[p..p + 3].copy_from_slice(i.set.reference_point.as_slice());
+                    let r = InterfaceQuantity::Rotation.slot() as usize;
+                    values[r..r + 9]
+                        .copy_from_slice(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+                }
+                values
+            })
+            .collect();
+        Ok(Slave {
+            body_file,
+            variables,
+            guid,
+            mesh,
+            interfaces,
+            clamped,
+            element_regions,
+            size,
+            parameters: defaults.clone(),
+            defaults,
+            inputs: default_inputs.clone(),
+            default_inputs,
+            input_derivatives: vec![[[0.0; 30]; 2]; n_interfaces],
+            input_times: vec![0.0; n_interfaces],
+            input_ages: vec![0.0; n_interfaces],
+            driving: vec![DrivingFrame::default(); n_interfaces],
+            start_time: 0.0,
+            model: None,
+            dynamics: None,
+            backup: None,
+            retry_backup: None,
+            outputs: Outputs {
+                interfaces: vec![[0.0; 30]; n_interfaces],
+                ..Outputs::default()
+            },
+            statistics: (0, 0),
+            retries: 0,
+            events: Vec::new(),
+            results: None,
+        })
+    }
+
+    /// The GUID of this body (fixed variable table, crate version and body file).
+    pub fn guid(&self) -> &str {
+        &self.guid
+    }
+
+    /// The body file this instance was built from.
+    pub fn body_file(&self) -> &BodyFile {
+        &self.body_file
+    }
+
+    /// The mesh of the body.
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// The variable table (value references, causality, variability).
+    pub fn variables(&self) -> &VariableTable {
+        &self.variables
+    }
+
+    /// The current parameter values.
+    pub fn parameters(&self) -> &Parameters {
+        &self.parameters
+    }
+
+    /// `fmi2SetupExperiment`: start time; stop time and tolerance are optional (and not needed).
+    pub fn setup_experiment(
+        &mut self,
+        start_time: f64,
+        stop_time: Option<f64>,
+        tolerance: Option<f64>,
+    ) -> Result<()> {
+        if !start_time.is_finite() {
+            return Err(Error::invalid_value(
+                "startTime",
+                start_time,
+                "not a finite number",
+            ));
+        }
+        if let Some(stop) = stop_time {
+            if stop.is_nan() || stop < start_time {
+                return Err(Error::invalid_value(
+                    "stopTime",
+                    stop,
+                    "must not be before startTime",
+                ));
+            }
+        }
+        let _ = tolerance; // the body's own solver.tolerance governs the iteration
+        self.start_time = start_time;
+        // Inputs set before the experiment is set up describe the start.
+        self.input_times.fill(start_time);
+        Ok(())
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization_mode(&mut self) -> Result<()> {
+        self.dynamics = None;
+        self.input_times.fill(self.start_time);
+        self.outputs.valid = false;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: validates the parameters, assembles and places the body,
+    /// factorises the iteration matrix for `solver.stepSize`.
+    pub fn exit_initialization_mode(&mut self) -> Result<()> {
+        self.ensure_initial_state()?;
+        let h = self.parameters.step_size;
+        self.matrix_index(h)?;
+        self.results = None;
+        if !self.parameters.output_directory.is_empty() {
+            match ResultWriter::create(
+                &self.parameters.output_directory,
+                &file_stem(&self.body_file.name),
+                self.parameters.output_interval,
+            ) {
+                Ok(writer) => {
+                    self.events.push(LogEvent {
+                        category: "logEvents",
+                        message: format!(
+                            "output.directory: writing VTK results to {}",
+                            writer.collection_path().display()
+                        ),
+                    });
+                    self.results = Some(writer);
+                    self.write_results();
+                }
+                Err(e) => self.output_failed(&e),
+            }
+        }
+        Ok(())
+    }
+
+    /// Current simulation time (s): the last successful communication point.
+    pub fn time(&self) -> f64 {
+        self.dynamics
+            .as_ref()
+            .map_or(self.start_time, |d| d.state.time)
+    }
+
+    /// Positions, velocities and accelerations (flat `3N`) once initialized.
+    pub fn dynamic_state(&self) -> Option<&DynamicState> {
+        self.dynamics.as_ref().map(|d| &d.state)
+    }
+
+    /// The free nodes, their reduced matrices and constraints once initialized.
+    pub fn free_nodes(&self) -> Option<&FreeNodes> {
+        self.model.as_ref().map(|m| &m.free)
+    }
+
+    /// The cached factorization of the iteration matrix for internal step `h`, if a step of that
+    /// size has been taken (for measurements: the floor of a step is one solve with it).
+    pub fn iteration_matrix(&self, h: f64) -> Option<&IterationMatrix> {
+        self.model
+            .as_ref()?
+            .matrices
+            .iter()
+            .find(|m| (m.step_size - h).abs() <= 1e-9 * h)
+    }
+
+    /// The assembled body once initialized.
+    pub fn body(&self) -> Option<&Body> {
+        self.model.as_ref().map(|m| &m.body)
+    }
+
+    /// Takes the log messages produced since the last call (none on the hot path).
+    pub fn drain_events(&mut self) -> std::vec::Drain<'_, LogEvent> {
+        self.events.drain(..)
+    }
+
+    /// Internal steps taken and fixed-point iterations done since instantiation.
+    pub fn solver_statistics(&self) -> (u64, u64) {
+        self.statistics
+    }
+
+    /// Step sizes with a factorization in the cache (at most [`MATRIX_CACHE_SIZE`]), most
+    /// recently used last.
+    pub fn cached_step_sizes(&self) -> Vec<f64> {
+        self.model
+            .as_ref()
+            .map_or_else(Vec::new, |m| match &m.radau {
+                Some(radau) => radau.matrices.iter().map(|x| x.step_size).collect(),
+                None => m.matrices.iter().map(|x| x.step_size).collect(),
+            })
+    }
+
+    /// Internal steps that did not converge and were retried with halved steps (each retry
+    /// counts once per halving).
+    pub fn step_retries(&self) -> u64 {
+        self.retries
+    }
+
+    /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values). The
+    /// assembled matrices are kept for reuse if the parameters come back the same.
+    pub fn reset(&mut self) {
+        self.parameters = self.defaults.clone();
+        self.inputs.clone_from(&self.default_inputs);
+        for d in &mut self.input_derivatives {
+            *d = [[0.0; 30]; 2];
+        }
+        self.start_time = 0.0;
+        self.input_times.fill(0.0);
+        self.dynamics = None;
+        self.backup = None;
+        self.statistics = (0, 0);
+        self.retries = 0;
+        self.outputs.valid = false;
+        self.results = None;
+    }
+
+    /// `fmi2GetFMUstate`.
+    pub fn get_state(&self) -> SlaveState {
+        SlaveState {
+            parameters: self.parameters.clone(),
+            inputs: self.inputs.clone(),
+            input_derivatives: self.input_derivatives.clone(),
+            input_times: self.input_times.clone(),
+            start_time: self.start_time,
+            dynamics: self.dynamics.clone(),
+            counters: [self.statistics.0, self.statistics.1, self.retries],
+        }
+    }
+
+    /// `fmi2SetFMUstate`.
+    pub fn set_state(&mut self, state: &SlaveState) -> Result<()> {
+        if state.inputs.len() != self.inputs.len()
+            || state.input_derivatives.len() != self.inputs.len()
+            || state.input_times.len() != self.inputs.len()
+        {
+            return Err(Error::new("the FMU state belongs to another body"));
+        }
+        self.parameters = state.parameters.clone();
+        self.inputs.clone_from(&state.inputs);
+        self.input_derivatives.clone_from(&state.input_derivatives);
+        self.input_times.clone_from(&state.input_times);
+        self.start_time = state.start_time;
+        self.statistics = (state.counters[0], state.counters[1]);
+        self.retries = state.counters[2];
+        if let Some(d) = &state.dynamics {
+            self.ensure_model()?;
+            let expected = 3 * self.model.as_ref().unwrap().body.node_count();
+            if d.state.position.len() != expected {
+                return Err(Error::new(format!(
+                    "the FMU state has {} coordinates, this body (model.modes = {}) has {expected}: it belongs to another body",
+                    d.state.position.len(),
+                    self.parameters.modes
+                )));
+            }
+        }
+        match (&mut self.dynamics, &state.dynamics) {
+            (Some(d), Some(s)) if d.state.position.len() == s.state.position.len() => {
+                d.state.copy_from(&s.state);
+                d.loads.clone_from(&s.loads);
+                d.gravity = s.gravity;
+                d.features = s.features;
+                d.quiet_since = s.quiet_since;
+            }
+            (d, s) => *d = s.clone(),
+        }
+        if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
+            model.apply_features(d.features);
+        }
+        self.outputs.valid = false;
+        Ok(())
+    }
+
+    /// The complete `modelDescription.xml` of this body.
+    pub fn model_description(&self) -> String {
+        let info = ModelInfo {
+            model_name: self.body_file.name.clone(),
+            description: self.body_file.description.clone(),
+            guid: self.guid.clone(),
+            generation_tool: format!("flexbody {}", env!("CARGO_PKG_VERSION")),
+            default_step_size: self.defaults.step_size,
+        };
+        model_description(&self.variables, &info, &|v: &Variable| self.start_value(v))
+    }
+}
+
+/// GUID of a body: FNV-1a (two seeds) of the fixed table's fingerprint, the crate version and the
+/// canonical body file, formatted as a UUID.
+pub fn guid_of(body_file: &BodyFile) -> String {
+    let text = format!(
+        "{FIXED_TABLE_FINGERPRINT:x}|{}|{}",
+        env!("CARGO_PKG_VERSION"),
+        body_file.to_canonical_json()
+    );
+    let fnv = |seed: u64| {
+        let mut h = seed;
+        for b in text.bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x100000001b3);
+        }
+        h
+    };
+    let (a, b) = (fnv(0xcbf29ce484222325), fnv(0x84222325cbf29ce4));
+    format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        a >> 32,
+        (a >> 16) & 0xffff,
+        a & 0xffff,
+        b >> 48,
+        b & 0xffff_ffff_ffff
+    )
+}

@@ -1,0 +1,216 @@
+//! The parameters of the body (`Parameters`, set from the body file and by the importer) and
+//! their mapping to the fixed variables of the variable table.
+
+use crate::error::{Error, Result};
+use crate::fem::IsotropicMaterial;
+use crate::model::body_file::Integrator;
+use crate::model::variables::FixedKey;
+use crate::model::BodyFile;
+use crate::solver::anderson::MAX_DEPTH;
+
+/// `model.formulation` item of the full nonlinear reference.
+pub(super) const FORMULATION_FULL: i32 = 2;
+
+/// `model.stiffening` items.
+pub(super) const STIFFENING_NONE: i32 = 1;
+
+pub(super) const STIFFENING_INERTIAL: i32 = 2;
+
+pub(super) const STIFFENING_STRESS: i32 = 3;
+
+/// `solver.integrator` items.
+pub(super) const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
+
+pub(super) const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
+
+pub(super) const INTEGRATOR_RADAU: i32 = 3;
+
+/// The parameters of DESIGN.md section 4 (SI units).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameters {
+    pub material: IsotropicMaterial,
+    pub damping_alpha: f64,
+    pub damping_beta: f64,
+    pub gravity: [f64; 3],
+    pub initial_position: [f64; 3],
+    /// Row-major.
+    pub initial_rotation: [f64; 9],
+    pub initial_velocity: [f64; 3],
+    pub initial_angular_velocity: [f64; 3],
+    pub step_size: f64,
+    pub rho_inf: f64,
+    pub tolerance: f64,
+    pub max_iterations: i32,
+    pub nonlinear_forces: bool,
+    /// `model.auto`: with it `nonlinear_forces` and `stiffening` are what is allowed and the
+    /// slave switches each on per step when its indicator says it matters (see [`Features`]).
+    pub auto: bool,
+    /// `model.formulation`: 1 reducedStrain, 2 full.
+    pub formulation: i32,
+    /// `model.stiffening`: 1 none, 2 inertial, 3 stress.
+    pub stiffening: i32,
+    /// `model.frames`: co-moving frames of the reduced-strain body (≥ 1).
+    pub frames: i32,
+    /// `model.modes`: 0 the full mesh, `n > 0` the reduced body with `n` fixed-interface modes.
+    pub modes: i32,
+    /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
+    pub anderson_depth: i32,
+    /// `solver.integrator`: 1 generalized-α, 2 central difference, 3 Radau IIA.
+    pub integrator: i32,
+    /// `output.directory`: where VTK results go; empty: none (see [`crate::output`]).
+    pub output_directory: String,
+    /// `output.interval` (s): smallest time between saved results; 0: every communication point.
+    pub output_interval: f64,
+}
+
+impl Parameters {
+    pub(super) fn from_body_file(b: &BodyFile) -> Parameters {
+        Parameters {
+            material: IsotropicMaterial {
+                youngs_modulus: b.material.youngs_modulus,
+                poisson_ratio: b.material.poisson_ratio,
+                density: b.material.density,
+            },
+            damping_alpha: b.damping.alpha,
+            damping_beta: b.damping.beta,
+            gravity: b.gravity,
+            initial_position: [0.0; 3],
+            initial_rotation: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+            initial_velocity: [0.0; 3],
+            initial_angular_velocity: [0.0; 3],
+            step_size: b.solver.step_size,
+            rho_inf: b.solver.rho_inf,
+            tolerance: b.solver.tolerance,
+            max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
+            nonlinear_forces: b.model.nonlinear_forces,
+            auto: b.model.auto,
+            formulation: 1,
+            stiffening: 1,
+            frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
+            modes: b.model.modes.min(i32::MAX as u32) as i32,
+            anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
+            integrator: match b.solver.integrator {
+                Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
+                Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
+                Integrator::RadauIIA => INTEGRATOR_RADAU,
+            },
+            output_directory: String::new(),
+            output_interval: 0.0,
+        }
+    }
+
+    /// The parameters that the assembled model depends on (everything but gravity, the initial
+    /// placement, the step size and the iteration settings).
+    pub(super) fn model_key(&self) -> ModelKey {
+        (
+            self.material,
+            [
+                self.damping_alpha.to_bits(),
+                self.damping_beta.to_bits(),
+                self.rho_inf.to_bits(),
+            ],
+            [self.nonlinear_forces, self.auto],
+            [
+                self.formulation * 16 + self.stiffening,
+                self.frames,
+                self.anderson_depth,
+                self.integrator,
+                self.modes,
+            ],
+        )
+    }
+
+    /// Checks one Real parameter value; the error names the variable, the value and the reason.
+    pub(super) fn check_real(name: &str, key: FixedKey, value: f64) -> Result<()> {
+        if !value.is_finite() {
+            return Err(Error::invalid_value(name, value, "not a finite number"));
+        }
+        let reason = match key {
+            FixedKey::YoungsModulus if value <= 0.0 => Some("must be positive"),
+            FixedKey::Density if value <= 0.0 => Some("must be positive"),
+            FixedKey::PoissonRatio if !(value > -1.0 && value < 0.5) => {
+                Some("must lie in (-1, 0.5): 0.5 is incompressible, which a displacement formulation cannot represent")
+            }
+            FixedKey::DampingAlpha | FixedKey::DampingBeta if value < 0.0 => {
+                Some("must not be negative (negative damping adds energy)")
+            }
+            FixedKey::StepSize if value <= 0.0 => Some("must be positive"),
+            FixedKey::RhoInf if !(0.0..=1.0).contains(&value) => Some("must lie in [0, 1]"),
+            FixedKey::Tolerance if !(value > 0.0 && value < 1.0) => Some("must lie in (0, 1)"),
+            FixedKey::OutputInterval if value < 0.0 => Some("must not be negative"),
+            _ => None,
+        };
+        match reason {
+            Some(r) => Err(Error::invalid_value(name, value, r)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What the assembled model depends on (see [`Parameters::model_key`]).
+pub(super) type ModelKey = (IsotropicMaterial, [u64; 3], [bool; 2], [i32; 5]);
+
+/// Value of a Real parameter (`None` for outputs and non-Real keys). Allocation-free.
+pub(super) fn read_parameter(p: &Parameters, key: FixedKey, c: usize) -> Option<f64> {
+    use FixedKey::*;
+    Some(match key {
+        YoungsModulus => p.material.youngs_modulus,
+        PoissonRatio => p.material.poisson_ratio,
+        Density => p.material.density,
+        DampingAlpha => p.damping_alpha,
+        DampingBeta => p.damping_beta,
+        Gravity => p.gravity[c],
+        InitialPosition => p.initial_position[c],
+        InitialRotation => p.initial_rotation[c],
+        InitialVelocity => p.initial_velocity[c],
+        InitialAngularVelocity => p.initial_angular_velocity[c],
+        StepSize => p.step_size,
+        RhoInf => p.rho_inf,
+        Tolerance => p.tolerance,
+        OutputInterval => p.output_interval,
+        _ => return None,
+    })
+}
+
+/// The storage of a Real parameter (`None` for outputs and non-Real keys).
+pub(super) fn write_parameter(p: &mut Parameters, key: FixedKey, c: usize) -> Option<&mut f64> {
+    use FixedKey::*;
+    Some(match key {
+        YoungsModulus => &mut p.material.youngs_modulus,
+        PoissonRatio => &mut p.material.poisson_ratio,
+        Density => &mut p.material.density,
+        DampingAlpha => &mut p.damping_alpha,
+        DampingBeta => &mut p.damping_beta,
+        Gravity => &mut p.gravity[c],
+        InitialPosition => &mut p.initial_position[c],
+        InitialRotation => &mut p.initial_rotation[c],
+        InitialVelocity => &mut p.initial_velocity[c],
+        InitialAngularVelocity => &mut p.initial_angular_velocity[c],
+        StepSize => &mut p.step_size,
+        RhoInf => &mut p.rho_inf,
+        Tolerance => &mut p.tolerance,
+        OutputInterval => &mut p.output_interval,
+        _ => return None,
+    })
+}
+
+pub(super) fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
+    match key {
+        FixedKey::MaxIterations => Some(p.max_iterations),
+        FixedKey::Formulation => Some(p.formulation),
+        FixedKey::Stiffening => Some(p.stiffening),
+        FixedKey::Frames => Some(p.frames),
+        FixedKey::Modes => Some(p.modes),
+        FixedKey::AndersonDepth => Some(p.anderson_depth),
+        FixedKey::Integrator => Some(p.integrator),
+        _ => None,
+    }
+}
+
+pub(super) fn read_boolean(p: &Parameters, key: FixedKey) -> Option<bool> {
+    match key {
+        FixedKey::NonlinearForces => Some(p.nonlinear_forces),
+        FixedKey::Auto => Some(p.auto),
+        _ => None,
+    }
+}

@@ -1,0 +1,431 @@
+//! Variable access by value reference: typed get and set, start values, input derivatives.
+
+use super::parameters::{read_boolean, read_integer, read_parameter, write_parameter, Parameters};
+use super::{Slave, MAX_INPUT_DERIVATIVE_ORDER};
+use crate::error::{Error, Result};
+use crate::model::model_description::format_real;
+use crate::model::variables::{EnumerationSpec, FixedKey, InterfaceQuantity};
+use crate::model::{InterfaceKind, Target, Variable, VariableType};
+use crate::solver::anderson::MAX_DEPTH;
+
+pub(super) fn component_of(v: &Variable) -> usize {
+    match v.target {
+        Target::Fixed { component, .. } | Target::Interface { component, .. } => component,
+    }
+}
+
+/// Offset of a body output in [`Outputs::body`].
+pub(super) fn body_output_slot(key: FixedKey) -> usize {
+    match key {
+        FixedKey::BodyPosition => 0,
+        FixedKey::BodyRotation => 3,
+        FixedKey::BodyVelocity => 12,
+        FixedKey::BodyAngularVelocity => 15,
+        FixedKey::BodyLinearMomentum => 18,
+        FixedKey::BodyAngularMomentum => 21,
+        FixedKey::BodyKineticEnergy => 24,
+        FixedKey::BodyStrainEnergy => 25,
+        _ => unreachable!("{key:?} is not a body output"),
+    }
+}
+
+impl Slave {
+    /// Sets a Real, Integer or Boolean variable by name (for scripts and measurements: an
+    /// Integer takes `value` when it is integral, a Boolean `value != 0`); the same checks as
+    /// the typed setters.
+    pub fn set_by_name(&mut self, name: &str, value: f64) -> Result<()> {
+        let v = self
+            .variables
+            .by_name(name)
+            .ok_or_else(|| Error::new(format!("no variable is named {name}")))?;
+        let (vr, ty) = (v.value_reference, v.ty);
+        match ty {
+            VariableType::Real => self.set_real(vr, value),
+            VariableType::Integer if value.fract() == 0.0 && value.abs() <= i32::MAX as f64 => {
+                self.set_integer(vr, value as i32)
+            }
+            VariableType::Integer => Err(Error::invalid_value(name, value, "not an integer")),
+            VariableType::Boolean => self.set_boolean(vr, value != 0.0),
+            VariableType::String => Err(Error::new(format!(
+                "{name} is a String variable: use set_string"
+            ))),
+        }
+    }
+
+    /// A Real variable by name.
+    pub fn get_by_name(&mut self, name: &str) -> Result<f64> {
+        let vr = self
+            .variables
+            .by_name(name)
+            .ok_or_else(|| Error::new(format!("no variable is named {name}")))?
+            .value_reference;
+        self.get_real(vr)
+    }
+
+    /// Value of a String variable.
+    pub fn get_string(&mut self, vr: u32) -> Result<String> {
+        let v = self.lookup(VariableType::String, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::OutputDirectory,
+                ..
+            } => Ok(self.parameters.output_directory.clone()),
+            _ => Err(Error::new(format!(
+                "no String variable has value reference {vr}"
+            ))),
+        }
+    }
+
+    /// Sets a String parameter (`output.directory`: any text; a directory that cannot be created
+    /// is reported when the results are first written).
+    pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        let v = self.lookup(VariableType::String, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::OutputDirectory,
+                ..
+            } => {
+                self.parameters.output_directory = value.to_string();
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    /// Start value of a parameter or input as written in the XML (full precision).
+    pub(super) fn start_value(&self, v: &Variable) -> String {
+        match (v.ty, v.target) {
+            (VariableType::Boolean, Target::Fixed { key, .. }) => read_boolean(&self.defaults, key)
+                .unwrap_or(false)
+                .to_string(),
+            (VariableType::Integer, Target::Fixed { key, .. }) => {
+                read_integer(&self.defaults, key).unwrap_or(0).to_string()
+            }
+            (VariableType::Real, Target::Fixed { key, component }) => {
+                format_real(read_parameter(&self.defaults, key, component).unwrap_or(0.0))
+            }
+            (VariableType::String, Target::Fixed { .. }) => self.defaults.output_directory.clone(),
+            (
+                VariableType::Real,
+                Target::Interface {
+                    index,
+                    quantity,
+                    component,
+                },
+            ) => format_real(self.default_inputs[index][quantity.slot() as usize + component]),
+            _ => "0".to_string(),
+        }
+    }
+
+    pub(super) fn lookup(&self, ty: VariableType, vr: u32) -> Result<Variable> {
+        self.variables
+            .get(ty, vr)
+            .cloned()
+            .ok_or_else(|| Error::new(format!("no {ty:?} variable has value reference {vr}")))
+    }
+
+    /// Value of a Real variable.
+    pub fn get_real(&mut self, vr: u32) -> Result<f64> {
+        let (target, causality) = match self.variables.get(VariableType::Real, vr) {
+            Some(v) => (v.target, v.causality),
+            None => {
+                return Err(Error::new(format!(
+                    "no Real variable has value reference {vr}"
+                )))
+            }
+        };
+        let value = match target {
+            Target::Fixed { key, component } => {
+                match read_parameter(&self.parameters, key, component) {
+                    Some(p) => p,
+                    None => {
+                        self.ensure_outputs()?;
+                        self.outputs.body[body_output_slot(key) + component]
+                    }
+                }
+            }
+            Target::Interface {
+                index,
+                quantity,
+                component,
+            } => {
+                if causality == crate::model::Causality::Input {
+                    self.inputs[index][quantity.slot() as usize + component]
+                } else {
+                    self.ensure_outputs()?;
+                    self.outputs.interfaces[index][quantity.slot() as usize + component]
+                }
+            }
+        };
+        // Never hand out a NaN: the state is checked after every step, so this is a guard.
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(Error::new(format!(
+                "value reference {vr} evaluated to {value}: the state is not finite"
+            )))
+        }
+    }
+
+    /// Sets a Real parameter or input; rejects NaN, infinities and out-of-range values with a
+    /// message naming the variable; a rejected value changes nothing. Allocation-free unless it
+    /// fails.
+    pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        match v.target {
+            Target::Fixed { key, component } => {
+                Parameters::check_real(&v.name, key, value)?;
+                let p = write_parameter(&mut self.parameters, key, component).ok_or_else(|| {
+                    Error::new(format!("{} is an output and cannot be set", v.name))
+                })?;
+                *p = value;
+            }
+            Target::Interface {
+                index,
+                quantity,
+                component,
+            } => {
+                if !value.is_finite() {
+                    return Err(Error::invalid_value(&v.name, value, "not a finite number"));
+                }
+                if v.causality != crate::model::Causality::Input {
+                    return Err(Error::new(format!(
+                        "{} is an output and cannot be set",
+                        v.name
+                    )));
+                }
+                self.resample_inputs(index);
+                self.inputs[index][quantity.slot() as usize + component] = value;
+            }
+        }
+        Ok(())
+    }
+
+    pub fn get_integer(&mut self, vr: u32) -> Result<i32> {
+        let v = self.lookup(VariableType::Integer, vr)?;
+        match v.target {
+            Target::Fixed { key, .. } => read_integer(&self.parameters, key),
+            _ => None,
+        }
+        .ok_or_else(|| Error::new(format!("no Integer variable has value reference {vr}")))
+    }
+
+    pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
+        let v = self.lookup(VariableType::Integer, vr)?;
+        if let Some(e) = v.declared_type.and_then(EnumerationSpec::by_name) {
+            if value < 1 || value as usize > e.items.len() {
+                let names: Vec<String> = e
+                    .items
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (name, _))| format!("{} = {name}", k + 1))
+                    .collect();
+                return Err(Error::invalid_value(
+                    &v.name,
+                    value,
+                    &format!("not an item of {} ({})", e.name, names.join(", ")),
+                ));
+            }
+        }
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::MaxIterations,
+                ..
+            } => {
+                if value < 1 {
+                    return Err(Error::invalid_value(&v.name, value, "must be at least 1"));
+                }
+                self.parameters.max_iterations = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Integrator,
+                ..
+            } => {
+                self.parameters.integrator = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::AndersonDepth,
+                ..
+            } => {
+                if !(0..=MAX_DEPTH as i32).contains(&value) {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        &format!("must lie in [0, {MAX_DEPTH}]"),
+                    ));
+                }
+                self.parameters.anderson_depth = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Formulation,
+                ..
+            } => {
+                self.parameters.formulation = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Stiffening,
+                ..
+            } => {
+                self.parameters.stiffening = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Frames,
+                ..
+            } => {
+                if value < 1 || value as usize > self.mesh.element_count() {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        &format!(
+                            "must lie in [1, {}] (the number of elements)",
+                            self.mesh.element_count()
+                        ),
+                    ));
+                }
+                self.parameters.frames = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Modes,
+                ..
+            } => {
+                if value < 0 {
+                    return Err(Error::invalid_value(
+                        &v.name,
+                        value,
+                        "must not be negative (0: the full mesh)",
+                    ));
+                }
+                self.parameters.modes = value;
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    pub fn get_boolean(&mut self, vr: u32) -> Result<bool> {
+        let v = self.lookup(VariableType::Boolean, vr)?;
+        match v.target {
+            Target::Fixed { key, .. } => read_boolean(&self.parameters, key),
+            _ => None,
+        }
+        .ok_or_else(|| Error::new(format!("no Boolean variable has value reference {vr}")))
+    }
+
+    pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
+        let v = self.lookup(VariableType::Boolean, vr)?;
+        match v.target {
+            Target::Fixed {
+                key: FixedKey::NonlinearForces,
+                ..
+            } => {
+                self.parameters.nonlinear_forces = value;
+                Ok(())
+            }
+            Target::Fixed {
+                key: FixedKey::Auto,
+                ..
+            } => {
+                self.parameters.auto = value;
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    /// Checks a value for a Real variable as [`Slave::set_real`] would, without setting it (so
+    /// that an `fmi2SetReal` call with one bad value sets none). Allocation-free unless it fails.
+    pub fn check_real(&self, vr: u32, value: f64) -> Result<()> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        match v.target {
+            Target::Fixed { key, .. } => Parameters::check_real(&v.name, key, value),
+            Target::Interface { .. } if !value.is_finite() => {
+                Err(Error::invalid_value(&v.name, value, "not a finite number"))
+            }
+            Target::Interface { .. } => Ok(()),
+        }
+    }
+
+    /// `fmi2SetRealInputDerivatives`: `values[k]` is the `orders[k]`-th time derivative (1 or 2)
+    /// of the force or torque input `vrs[k]` of a force interface, with respect to the
+    /// communication point. Over the following `fmi2DoStep` the input is extrapolated as
+    /// `u(t) = u + u'·(t − t_c) + u''·(t − t_c)²/2` and applied at the end of every internal
+    /// step (see [`Slave::do_step`]); a derivative stays in force until it is set again (0
+    /// switches it off) and `fmi2Reset` clears it. Motion interfaces already extrapolate their
+    /// pose with their velocity inputs: derivatives of their inputs are refused. All or nothing:
+    /// one rejected entry sets none. Allocation-free unless it fails.
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> Result<()> {
+        for ((&vr, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            self.input_derivative_slot(vr, order, value)?;
+        }
+        for ((&vr, &order), &value) in vrs.iter().zip(orders).zip(values) {
+            let (index, order, slot) = self.input_derivative_slot(vr, order, value)?;
+            self.resample_inputs(index);
+            self.input_derivatives[index][order][slot] = value;
+        }
+        Ok(())
+    }
+
+    /// Where derivative `order` of input `vr` is kept (interface, order − 1, slot), after
+    /// checking the request.
+    pub(super) fn input_derivative_slot(
+        &self,
+        vr: u32,
+        order: i32,
+        value: f64,
+    ) -> Result<(usize, usize, usize)> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        if v.causality != crate::model::Causality::Input {
+            return Err(Error::new(format!(
+                "{} (value reference {vr}) is not an input: only inputs have derivatives to set",
+                v.name
+            )));
+        }
+        if !(1..=MAX_INPUT_DERIVATIVE_ORDER).contains(&order) {
+            return Err(Error::invalid_value(
+                &format!("the order of the derivative of {}", v.name),
+                order,
+                &format!("must be 1 or {MAX_INPUT_DERIVATIVE_ORDER}"),
+            ));
+        }
+        if !value.is_finite() {
+            return Err(Error::invalid_value(
+                &format!("derivative of order {order} of {}", v.name),
+                value,
+                "not a finite number",
+            ));
+        }
+        match v.target {
+            Target::Interface {
+                index,
+                quantity: q @ (InterfaceQuantity::Force | InterfaceQuantity::Torque),
+                component,
+            } if self.interfaces[index].kind == InterfaceKind::Force => {
+                Ok((index, order as usize - 1, q.slot() as usize + component))
+            }
+            _ => Err(Error::new(format!(
+                "{} (value reference {vr}): input derivatives are supported for the force and torque inputs of force interfaces; a motion interface's pose is extrapolated with its velocity inputs",
+                v.name
+            ))),
+        }
+    }
+}
