@@ -11,7 +11,7 @@
 //! * `stiffness.txt`: `i j value` for every stored entry of the small-strain stiffness `K`
 //!   (3N × 3N, both triangles, DOF `3 i + c`).
 
-use flexbody::fem::sparse::SymmetricCsr;
+use flexbody::linalg::sparse::SymmetricCsr;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use std::io::Write;

@@ -12,6 +12,7 @@ pub mod error;
 pub mod fem;
 #[allow(unsafe_code)]
 pub mod fmi2;
+pub mod linalg;
 pub mod mesh;
 pub mod model;
 pub mod output;

@@ -5,8 +5,8 @@
 
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::linalg::SparseCholesky;
 use flexbody::mesh::{beam, ElementKind, Mesh, NodeSelector};
-use flexbody::solver::SparseCholesky;
 
 const LENGTH: f64 = 1.0;
 const SIDE: f64 = 0.02;

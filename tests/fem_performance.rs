@@ -2,11 +2,9 @@
 //! `cargo test --release --test fem_performance -- --ignored --nocapture`). The assertions only
 //! check that the results are usable; the figures are printed for the record.
 
-use flexbody::fem::{
-    lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial, SymmetricCsr,
-};
+use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::linalg::{SparseCholesky, SymmetricCsr};
 use flexbody::mesh::{beam, ElementKind, NodeSelector};
-use flexbody::solver::SparseCholesky;
 use std::time::Instant;
 
 fn time(divisions: [usize; 3]) {

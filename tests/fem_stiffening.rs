@@ -32,9 +32,10 @@ use flexbody::fem::element::{jacobian, natural_coordinates, shape_functions, MAX
 use flexbody::fem::geometric::{geometric_stiffness, stress_at_gauss_points, weighted_sum_into};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::quadrature::gauss_legendre_1d;
-use flexbody::fem::{scalar_mass_matrix, stiffness_matrix, IsotropicMaterial, SymmetricCsr};
+use flexbody::fem::{scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::linalg::SparseCholesky;
+use flexbody::linalg::SymmetricCsr;
 use flexbody::mesh::{beam, ElementKind, Mesh};
-use flexbody::solver::SparseCholesky;
 use std::f64::consts::PI;
 
 const LENGTH: f64 = 1.0;

@@ -8,8 +8,8 @@ use flexbody::fem::element::{edges, integration_rule, physical_gradients, shape_
 use flexbody::fem::element::{mass_rule, MAX_NODES};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::linalg::SparseCholesky;
 use flexbody::mesh::{beam, gmsh, ElementKind, Mesh, NodeSelector};
-use flexbody::solver::SparseCholesky;
 
 const LENGTH: f64 = 1.0;
 const SIDE: f64 = 0.02;

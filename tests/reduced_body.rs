@@ -7,13 +7,12 @@ mod common;
 use common::*;
 use flexbody::body::{NodeSet, Reduction};
 use flexbody::fem::modal::lowest_eigenpairs;
-use flexbody::fem::{
-    lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial, SymmetricCsr,
-};
+use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
+use flexbody::linalg::SparseCholesky;
+use flexbody::linalg::SymmetricCsr;
 use flexbody::mesh::{Mesh, NodeSelector};
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
-use flexbody::solver::SparseCholesky;
 use nalgebra::{DMatrix, DVector, Rotation3, Vector3};
 
 fn face(mesh: &Mesh, x: f64) -> Vec<usize> {

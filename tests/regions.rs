@@ -13,10 +13,10 @@
 mod common;
 use common::*;
 use flexbody::fem;
+use flexbody::linalg::SparseCholesky;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use flexbody::solver::central_difference::CentralDifference;
-use flexbody::solver::SparseCholesky;
 
 const E: f64 = 2.1e11;
 const NU: f64 = 0.3;

@@ -50,7 +50,7 @@ use super::stiffening::{inertial_coefficients, Stiffening};
 use super::strain_monitor::StrainMonitor;
 use super::Body;
 use crate::fem::modal::lowest_eigenpairs;
-use crate::fem::SymmetricCsr;
+use crate::linalg::SymmetricCsr;
 use crate::mesh::Mesh;
 use nalgebra::{Matrix3, Vector3};
 

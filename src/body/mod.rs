@@ -15,10 +15,10 @@ pub use interface::NodeSet;
 pub use patches::Patches;
 pub use reduction::Reduction;
 
-use crate::fem::dense::DenseSymmetric;
 use crate::fem::nonlinear::SvkSolid;
-use crate::fem::sparse::BlockCsr3;
-use crate::fem::SymmetricCsr;
+use crate::linalg::dense::DenseSymmetric;
+use crate::linalg::sparse::BlockCsr3;
+use crate::linalg::SymmetricCsr;
 use frame::{add_node, node, set_node};
 use nalgebra::{Matrix3, Vector3};
 

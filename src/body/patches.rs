@@ -24,8 +24,8 @@
 
 use super::frame::{add_node, node, set_node, FrameWeights};
 use crate::error::{Error, Result};
-use crate::fem::sparse::BlockCsr3;
 use crate::fem::{self, IsotropicMaterial};
+use crate::linalg::sparse::BlockCsr3;
 use crate::mesh::Mesh;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 

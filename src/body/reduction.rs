@@ -52,8 +52,8 @@ use super::frame::{node, FrameWeights};
 use super::interface::NodeSet;
 use crate::error::{Error, Result};
 use crate::fem::modal::lowest_eigenpairs;
-use crate::fem::SymmetricCsr;
-use crate::solver::cholesky::SparseCholesky;
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::SymmetricCsr;
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Scalar fields from a vector mode whose mass norm is below this fraction of the mode's

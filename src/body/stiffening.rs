@@ -16,9 +16,10 @@ use crate::fem::geometric::{
     gauss_point_count, geometric_stiffness, geometric_stiffness_into, stiffness_pattern,
     stress_at_gauss_points, stress_at_gauss_points_into, weighted_sum_into,
 };
-use crate::fem::{IsotropicMaterial, SymmetricCsr};
+use crate::fem::IsotropicMaterial;
+use crate::linalg::SparseCholesky;
+use crate::linalg::SymmetricCsr;
 use crate::mesh::Mesh;
-use crate::solver::SparseCholesky;
 use nalgebra::{Matrix3, Vector3};
 
 /// Which prestress drives the stiffening.

@@ -9,7 +9,8 @@
 
 use super::element::{integration_rule, mass_rule, physical_gradients, shape_functions, MAX_NODES};
 use super::quadrature::QuadraturePoint;
-use super::{IsotropicMaterial, SymmetricCsr};
+use super::IsotropicMaterial;
+use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 
 /// Shape function values and natural derivatives at the points of a rule of `kind`.
@@ -346,8 +347,8 @@ pub fn lumped_masses_of(mesh: &Mesh, density: &dyn Fn(usize) -> f64) -> Vec<f64>
 mod tests {
     use super::*;
     use crate::fem::element::{edges, natural_coordinates};
+    use crate::linalg::cholesky::SparseCholesky;
     use crate::mesh::beam;
-    use crate::solver::cholesky::SparseCholesky;
     use nalgebra::{DMatrix, SymmetricEigen};
 
     /// A distorted single element: the unit cube with corners moved (mid-edge nodes of Hex20 on

@@ -27,7 +27,8 @@
 
 pub use super::assembly::stiffness_pattern;
 use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
-use super::{IsotropicMaterial, SymmetricCsr};
+use super::IsotropicMaterial;
+use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 
 /// Gauss points of the stiffness rule per element of `kind` (8 for Hex8, 27 for Hex20, 1 for

@@ -3,14 +3,12 @@
 //! DOF numbering everywhere: `3 * node + direction`.
 
 pub mod assembly;
-pub mod dense;
 pub mod element;
 pub mod geometric;
 pub mod material;
 pub mod modal;
 pub mod nonlinear;
 pub mod quadrature;
-pub mod sparse;
 pub mod stress;
 
 pub use assembly::{
@@ -18,4 +16,3 @@ pub use assembly::{
     stiffness_matrix_of,
 };
 pub use material::IsotropicMaterial;
-pub use sparse::SymmetricCsr;

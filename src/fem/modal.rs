@@ -14,9 +14,9 @@
 //! and modes to about 1e-5 (relative). Requires `K` positive definite (constrained body) and `M`
 //! positive definite.
 
-use super::SymmetricCsr;
 use crate::error::{Error, Result};
-use crate::solver::cholesky::SparseCholesky;
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::SymmetricCsr;
 use nalgebra::DMatrix;
 
 /// The lowest generalized eigenpairs.
@@ -162,7 +162,7 @@ mod tests {
         // Fixed–fixed chain of n unit masses and unit springs: K = tridiag(−1, 2, −1), M = I,
         // eigenvalues 4 sin²(iπ / (2(n+1))).
         let n = 60;
-        let k = crate::fem::sparse::laplacian(n);
+        let k = crate::linalg::sparse::laplacian(n);
         let m = SymmetricCsr::from_triplets(n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
         let pairs = lowest_eigenpairs(&k, &m, 3, 1e-12, 200).unwrap();
         for (i, lambda) in pairs.eigenvalues.iter().enumerate() {

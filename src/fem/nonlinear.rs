@@ -30,7 +30,8 @@
 //! do not allocate.
 
 use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
-use super::{stiffness_matrix, IsotropicMaterial, SymmetricCsr};
+use super::{stiffness_matrix, IsotropicMaterial};
+use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 
 /// A St. Venant–Kirchhoff solid on a fixed reference mesh: the precomputed data of the strain
@@ -517,8 +518,8 @@ impl SvkSolid {
 #[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
+    use crate::linalg::cholesky::SparseCholesky;
     use crate::mesh::beam;
-    use crate::solver::cholesky::SparseCholesky;
 
     /// A material of unit modulus: energies, forces and stiffnesses are O(1) on O(1) meshes, so
     /// the finite-difference error estimates below are absolute numbers.

@@ -73,7 +73,7 @@ pub(super) struct Model {
     pub(super) allowed: Features,
     /// `K_G` while stiffening is switched off (it moves to `workspace.geometric_stiffness` and
     /// back: no allocation).
-    pub(super) parked_geometric_stiffness: Option<crate::fem::SymmetricCsr>,
+    pub(super) parked_geometric_stiffness: Option<crate::linalg::SymmetricCsr>,
 }
 
 impl Model {

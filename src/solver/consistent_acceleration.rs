@@ -11,9 +11,9 @@
 //! It serves the initial acceleration and the restart of the scheme when the held inputs jump
 //! at a communication point ([`super::generalized_alpha::restart_for_load_change`]).
 
-use super::cholesky::{SolveWorkspace, SparseCholesky};
 use super::generalized_alpha::FreeNodes;
 use crate::error::{Error, Result};
+use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use nalgebra::DMatrix;
 
 /// The factor of `Ms_FF` and the constraint projection.

@@ -16,9 +16,9 @@
 //! `Δx = Δx_u − hR Z μ`. After each iteration `C x = d` holds to round-off: the constraints do
 //! not drift (index 3, solved exactly for the multipliers; no stabilisation needed).
 
-use super::cholesky::{SolveWorkspace, SparseCholesky};
 use crate::body::frame::node;
 use crate::error::{Error, Result};
+use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// One point constraint: the weighted centroid of `nodes` held at `target` (m).

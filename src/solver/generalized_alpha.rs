@@ -19,14 +19,14 @@
 //! With `ρ∞ = 1` the scheme is the trapezoidal rule (energy-conserving on linear problems).
 
 use super::anderson::Anderson;
-use super::cholesky::{SolveWorkspace, SparseCholesky};
 use super::consistent_acceleration::ConsistentAcceleration;
 use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
 use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
 use crate::body::{Body, BodyKinematics, ForceScratch};
 use crate::error::{Error, Result};
-use crate::fem::SymmetricCsr;
+use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
+use crate::linalg::SymmetricCsr;
 
 /// Generalized-α coefficients from the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`:
 /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`, `β = ¼ (1 − α_m + α_f)²`

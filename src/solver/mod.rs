@@ -3,12 +3,8 @@
 
 pub mod anderson;
 pub mod central_difference;
-pub mod cholesky;
-pub mod complex_lu;
 pub mod consistent_acceleration;
 pub mod constraints;
 pub mod generalized_alpha;
 pub mod radau;
 pub mod woodbury;
-
-pub use cholesky::SparseCholesky;

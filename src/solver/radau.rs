@@ -28,7 +28,7 @@
 //! `S_γ = (γ²/h² + α_d γ/h) M + (1 + β_d γ/h) K`  (SPD: sparse Cholesky)
 //!
 //! and one complex one, `S_μ = (μ² + α_d μ) M + (1 + β_d μ) K`, `μ = (α + iβ)/h` (complex
-//! symmetric, indefinite real part: sparse LU over `c64`, [`super::complex_lu`]); `α_d`, `β_d`
+//! symmetric, indefinite real part: sparse LU over `c64`, [`crate::linalg::complex_lu`]); `α_d`, `β_d`
 //! are `damping.alpha`, `damping.beta`. Both are factorised once per step size and reused for
 //! the whole run. An iteration: three internal-force evaluations, rotate each residual into its
 //! stage's frame, transform with `T⁻¹`, one real and one complex solve, transform back with `T`,
@@ -48,8 +48,6 @@
 //! formulation (its tangent is not the rotated constant `K`).
 
 use super::anderson::Anderson;
-use super::cholesky::{SolveWorkspace, SparseCholesky};
-use super::complex_lu::ComplexLu;
 use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
 use super::generalized_alpha::{
     DynamicState, FreeNodes, IterationSettings, Prescription, StepReport, StepWorkspace,
@@ -58,6 +56,8 @@ use super::generalized_alpha::{
 use crate::body::frame::{node, set_node};
 use crate::body::Body;
 use crate::error::{Error, Result};
+use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
+use crate::linalg::complex_lu::ComplexLu;
 use faer::c64;
 use nalgebra::{Complex, DMatrix, Matrix3, Vector3};
 
@@ -246,7 +246,7 @@ impl RadauMatrix {
             ));
         }
         let g = tableau.gamma / h;
-        let s_real = crate::fem::SymmetricCsr::linear_combination(
+        let s_real = crate::linalg::SymmetricCsr::linear_combination(
             g * g + damping_alpha * g,
             &free.mass,
             1.0 + damping_beta * g,

@@ -21,10 +21,10 @@
 //! block products) and the 3×3 `(I + H⁻ᵀ A Y)⁻¹` once per step, at the predictor; each iteration
 //! then adds O(N) work to its one solve.
 
-use super::cholesky::{SolveWorkspace, SparseCholesky};
 use super::generalized_alpha::FreeNodes;
 use crate::body::frame::node;
 use crate::body::Body;
+use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use nalgebra::{Matrix3, Vector3};
 
 /// `Y = S̄⁻¹ B` for one factorization, and the per-step data of the correction.

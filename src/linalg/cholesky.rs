@@ -9,8 +9,8 @@
 //! the same solution either way (they only apply `A⁻¹` to a residual).
 
 use crate::error::{Error, Result};
-use crate::fem::dense::DenseSymmetric;
-use crate::fem::SymmetricCsr;
+use crate::linalg::dense::DenseSymmetric;
+use crate::linalg::SymmetricCsr;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltParams;
 use faer::sparse::linalg::cholesky::{
@@ -247,7 +247,7 @@ impl SparseCholesky {
 mod tests {
     use super::*;
 
-    use crate::fem::sparse::laplacian;
+    use crate::linalg::sparse::laplacian;
 
     #[test]
     fn solves_a_known_system() {

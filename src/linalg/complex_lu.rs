@@ -5,7 +5,7 @@
 //! size; solves take their workspace and do not allocate.
 
 use crate::error::{Error, Result};
-use crate::fem::SymmetricCsr;
+use crate::linalg::SymmetricCsr;
 use faer::c64;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
@@ -117,7 +117,7 @@ mod tests {
         // A = tridiag(−1, 2, −1), B = I: (−1 + 2i) I + A has an indefinite real part for the
         // low modes (eigenvalues of A lie in (0, 4)). Residual at round-off.
         let n = 60;
-        let a = crate::fem::sparse::laplacian(n);
+        let a = crate::linalg::sparse::laplacian(n);
         let b = SymmetricCsr::from_triplets(n, &(0..n).map(|i| (i, i, 1.0)).collect::<Vec<_>>());
         let (ca, cb) = (c64::new(1.0, 0.0), c64::new(-1.0, 2.0));
         let mut lu = ComplexLu::new(ca, &a, cb, &b).unwrap();
