@@ -3,72 +3,36 @@
 
 use super::assembly::Features;
 use super::auto_features::NOT_QUIET;
-use super::interfaces::{apply_loads, prescribe_motion};
+use super::interfaces::{apply_loads, prescribe_motion, rotation_input};
 use super::{Dynamics, Slave};
-use crate::body::frame::nearest_rotation;
 use crate::error::{Error, Result};
 use crate::model::InterfaceKind;
 use crate::solver::generalized_alpha::{self, DynamicState};
 use nalgebra::{Matrix3, Vector3};
 
+/// The rigid placement of the body at the start: `x_i = origin + Q (X_i − anchor)`,
+/// `ẋ_i = v + ω × Q (X_i − anchor)`.
+struct RigidPlacement {
+    origin: Vector3<f64>,
+    rotation: Matrix3<f64>,
+    anchor: Vector3<f64>,
+    velocity: Vector3<f64>,
+    angular_velocity: Vector3<f64>,
+    /// The interface whose inputs define it (the first motion interface), if any.
+    first_motion: Option<usize>,
+    /// What the velocities come from, for messages.
+    source: String,
+}
+
 impl Slave {
-    /// Places the body rigidly and computes the consistent initial acceleration (DESIGN.md
-    /// section 4): with motion interfaces, so that the first one's constraint holds at t0 with its
-    /// input velocities (the others must agree with that rigid placement); without, at
+    /// Places the body rigidly and computes the consistent initial acceleration (docs/fmu.md,
+    /// "Initialization"): with motion interfaces, so that the first one's constraint holds at t0
+    /// with its input velocities (the others must agree with that rigid placement); without, at
     /// `initial.position`/`initial.rotation` with `initial.velocity`/`initial.angularVelocity`.
     pub(super) fn ensure_initial_state(&mut self) -> Result<()> {
         self.ensure_model()?;
         self.update_driving_frames()?;
-        let p = &self.parameters;
-        // The placement x_i = origin + Q (X_i − anchor), ẋ_i = v + ω × Q (X_i − anchor).
-        let first_motion = self
-            .interfaces
-            .iter()
-            .position(|i| i.kind == InterfaceKind::Motion);
-        let (origin, q, anchor, v0, w0, source) = match first_motion {
-            Some(k) => {
-                let f = &self.driving[k];
-                let name = &self.body_file.interfaces[k].name;
-                (
-                    f.position,
-                    f.rotation,
-                    self.interfaces[k].set.reference_point,
-                    f.velocity,
-                    f.angular_velocity,
-                    format!("the inputs of motion interface '{name}'"),
-                )
-            }
-            None => {
-                let q = Matrix3::from_row_slice(&p.initial_rotation);
-                let deviation = (q.transpose() * q - Matrix3::identity()).amax();
-                if deviation > 1e-6 || q.determinant() <= 0.0 {
-                    return Err(Error::new(format!(
-                        "initial.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6})",
-                        p.initial_rotation,
-                        q.determinant()
-                    )));
-                }
-                (
-                    Vector3::from(p.initial_position),
-                    nearest_rotation(&q),
-                    Vector3::zeros(),
-                    Vector3::from(p.initial_velocity),
-                    Vector3::from(p.initial_angular_velocity),
-                    "initial.velocity and initial.angularVelocity".to_string(),
-                )
-            }
-        };
-        let has_fixed = self
-            .interfaces
-            .iter()
-            .any(|i| i.kind == InterfaceKind::Fixed);
-        if has_fixed && (v0.norm() > 0.0 || w0.norm() > 0.0) {
-            return Err(Error::new(format!(
-                "{source} rejected: velocity {:?}, angular velocity {:?}, but a body held by a fixed support must start at rest",
-                v0.as_slice(),
-                w0.as_slice()
-            )));
-        }
+        let placement = self.rigid_placement()?;
         let model = self.model.as_mut().unwrap();
         // model.auto starts with the terms that have an estimate off (the body is placed
         // rigidly: ū = 0, where both vanish); without it the switches are forced.
@@ -92,15 +56,117 @@ impl Slave {
             multipliers: vec![0.0; model.free.multiplier_count()],
         };
         body.place_rigidly(
-            &origin,
-            &q,
-            &anchor,
-            &v0,
-            &w0,
+            &placement.origin,
+            &placement.rotation,
+            &placement.anchor,
+            &placement.velocity,
+            &placement.angular_velocity,
             &mut state.position,
             &mut state.velocity,
         );
-        // Every other motion interface must hold in this rigid placement.
+        self.check_motion_interfaces(&state, placement.first_motion)?;
+        let model = self.model.as_ref().unwrap();
+        for interface in &self.interfaces {
+            if interface.kind == InterfaceKind::Fixed {
+                for i in interface.set.held_indices() {
+                    state.velocity[3 * i..3 * i + 3].fill(0.0);
+                }
+            }
+        }
+        prescribe_motion(
+            &model.body,
+            &self.interfaces,
+            &self.driving,
+            0.0,
+            &mut state,
+        );
+        self.hold_point_constraints(&state, &placement)?;
+        let model = self.model.as_mut().unwrap();
+        let body = &model.body;
+        let gravity = Vector3::from(self.parameters.gravity);
+        let interfaces = &self.interfaces;
+        let inputs = &self.inputs;
+        let loads =
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, None, &gravity, x, f);
+        generalized_alpha::initial_acceleration(
+            body,
+            &model.free,
+            &loads,
+            &mut state,
+            &mut model.workspace,
+            &mut model.mass,
+        )?;
+        if let Some(explicit) = &model.explicit {
+            // The explicit scheme's accelerations belong to the lumped mass.
+            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.workspace);
+        }
+        self.dynamics = Some(Dynamics {
+            state,
+            loads: self.inputs.clone(),
+            gravity: self.parameters.gravity,
+            features,
+            quiet_since: [NOT_QUIET; 2],
+        });
+        self.outputs.valid = false;
+        Ok(())
+    }
+
+    /// The rigid placement from the first motion interface's driving frame, or from the
+    /// `initial.*` parameters; a body held by a fixed support must start at rest.
+    fn rigid_placement(&self) -> Result<RigidPlacement> {
+        let p = &self.parameters;
+        let first_motion = self
+            .interfaces
+            .iter()
+            .position(|i| i.kind == InterfaceKind::Motion);
+        let placement = match first_motion {
+            Some(k) => {
+                let f = &self.driving[k];
+                let name = &self.body_file.interfaces[k].name;
+                RigidPlacement {
+                    origin: f.position,
+                    rotation: f.rotation,
+                    anchor: self.interfaces[k].set.reference_point,
+                    velocity: f.velocity,
+                    angular_velocity: f.angular_velocity,
+                    first_motion,
+                    source: format!("the inputs of motion interface '{name}'"),
+                }
+            }
+            None => RigidPlacement {
+                origin: Vector3::from(p.initial_position),
+                rotation: rotation_input("initial.rotation", &p.initial_rotation)?,
+                anchor: Vector3::zeros(),
+                velocity: Vector3::from(p.initial_velocity),
+                angular_velocity: Vector3::from(p.initial_angular_velocity),
+                first_motion,
+                source: "initial.velocity and initial.angularVelocity".to_string(),
+            },
+        };
+        let has_fixed = self
+            .interfaces
+            .iter()
+            .any(|i| i.kind == InterfaceKind::Fixed);
+        let (v0, w0) = (placement.velocity, placement.angular_velocity);
+        if has_fixed && (v0.norm() > 0.0 || w0.norm() > 0.0) {
+            return Err(Error::new(format!(
+                "{} rejected: velocity {:?}, angular velocity {:?}, but a body held by a fixed support must start at rest",
+                placement.source,
+                v0.as_slice(),
+                w0.as_slice()
+            )));
+        }
+        Ok(placement)
+    }
+
+    /// Every motion interface but the first must hold in the rigid placement `state` (to 1e-6
+    /// of the body's size).
+    fn check_motion_interfaces(
+        &self,
+        state: &DynamicState,
+        first_motion: Option<usize>,
+    ) -> Result<()> {
+        let body = &self.model.as_ref().unwrap().body;
         let tolerance = 1e-6 * self.size;
         for (k, interface) in self.interfaces.iter().enumerate() {
             if interface.kind != InterfaceKind::Motion || Some(k) == first_motion {
@@ -128,16 +194,18 @@ impl Slave {
                 )));
             }
         }
-        for interface in &self.interfaces {
-            if interface.kind == InterfaceKind::Fixed {
-                for i in interface.set.held_indices() {
-                    state.velocity[3 * i..3 * i + 3].fill(0.0);
-                }
-            }
-        }
-        prescribe_motion(body, &self.interfaces, &self.driving, 0.0, &mut state);
-        // Pins and hinges hold their centroids where the body was placed; the placement's
-        // velocity must not move them.
+        Ok(())
+    }
+
+    /// Pins and hinges hold their centroids where the body was placed; the placement's velocity
+    /// must not move them.
+    fn hold_point_constraints(
+        &mut self,
+        state: &DynamicState,
+        placement: &RigidPlacement,
+    ) -> Result<()> {
+        let model = self.model.as_mut().unwrap();
+        let (v0, w0) = (placement.velocity, placement.angular_velocity);
         for (k, interface) in self.interfaces.iter().enumerate() {
             let first = interface.first_constraint;
             for constraint in
@@ -147,39 +215,14 @@ impl Slave {
                 let speed = constraint.centroid(&state.velocity).norm();
                 if speed > 1e-9 * (1.0 + v0.norm() + w0.norm() * self.size) {
                     return Err(Error::new(format!(
-                        "{source} rejected: the initial velocity moves the {:?} support '{}' at {speed:.3e} m/s; the body may only turn about it",
+                        "{} rejected: the initial velocity moves the {:?} support '{}' at {speed:.3e} m/s; the body may only turn about it",
+                        placement.source,
                         interface.kind,
                         self.body_file.interfaces[k].name
                     )));
                 }
             }
         }
-        let body = &model.body;
-        let gravity = Vector3::from(p.gravity);
-        let interfaces = &self.interfaces;
-        let inputs = &self.inputs;
-        let loads =
-            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, inputs, None, &gravity, x, f);
-        generalized_alpha::initial_acceleration(
-            body,
-            &model.free,
-            &loads,
-            &mut state,
-            &mut model.workspace,
-            &mut model.mass,
-        )?;
-        if let Some(explicit) = &model.explicit {
-            // The explicit scheme's accelerations belong to the lumped mass.
-            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.workspace);
-        }
-        self.dynamics = Some(Dynamics {
-            state,
-            loads: self.inputs.clone(),
-            gravity: p.gravity,
-            features,
-            quiet_since: [NOT_QUIET; 2],
-        });
-        self.outputs.valid = false;
         Ok(())
     }
 }

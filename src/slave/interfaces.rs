@@ -107,24 +107,35 @@ pub(super) fn point_constraints(
     }
 }
 
-/// The driving frame of motion interface `name` from its inputs: a rotation input within 1e-3 of
-/// orthonormal is orthonormalised (nearest rotation), one further off is an error.
+/// How far from orthonormal a rotation given by the importer may be (`|QᵀQ − I|`, largest
+/// entry): within it the nearest rotation is used, beyond it the value is an error. Rotations
+/// typed with six digits, or integrated by a master over a long run, are a little off.
+pub(super) const ROTATION_TOLERANCE: f64 = 1e-3;
+
+/// The rotation `name` = `values` (row-major): the nearest rotation of a matrix within
+/// [`ROTATION_TOLERANCE`] of orthonormal with a positive determinant, otherwise an error naming
+/// the variable and the values.
+pub(super) fn rotation_input(name: &str, values: &[f64]) -> Result<Matrix3<f64>> {
+    let q = Matrix3::from_row_slice(values);
+    let deviation = (q.transpose() * q - Matrix3::identity()).amax();
+    if deviation > ROTATION_TOLERANCE || q.determinant() <= 0.0 {
+        return Err(Error::new(format!(
+            "{name} = {values:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); values within {ROTATION_TOLERANCE:e} of orthonormal are orthonormalised",
+            q.determinant()
+        )));
+    }
+    Ok(nearest_rotation(&q))
+}
+
+/// The driving frame of motion interface `name` from its inputs (the rotation through
+/// [`rotation_input`]).
 pub(super) fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame> {
     let slot = |q: InterfaceQuantity| q.slot() as usize;
     let vector = |q: InterfaceQuantity| Vector3::from_column_slice(&values[slot(q)..slot(q) + 3]);
     let r = slot(InterfaceQuantity::Rotation);
-    let q = Matrix3::from_row_slice(&values[r..r + 9]);
-    let deviation = (q.transpose() * q - Matrix3::identity()).amax();
-    if deviation > 1e-3 || q.determinant() <= 0.0 {
-        return Err(Error::new(format!(
-            "{name}.rotation = {:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); inputs within 1e-3 of orthonormal are orthonormalised",
-            &values[r..r + 9],
-            q.determinant()
-        )));
-    }
     Ok(DrivingFrame {
         position: vector(InterfaceQuantity::Position),
-        rotation: nearest_rotation(&q),
+        rotation: rotation_input(&format!("{name}.rotation"), &values[r..r + 9])?,
         velocity: vector(InterfaceQuantity::Velocity),
         angular_velocity: vector(InterfaceQuantity::AngularVelocity),
     })

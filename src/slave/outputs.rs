@@ -1,13 +1,14 @@
 //! Outputs, computed once per state on the first read, and their time derivatives.
 
-use super::interfaces::apply_loads;
-use super::{Slave, MAX_OUTPUT_DERIVATIVE_ORDER};
+use super::interfaces::{apply_loads, Interface};
+use super::{Inputs, Slave, MAX_OUTPUT_DERIVATIVE_ORDER};
 use crate::body::frame::node;
 use crate::body::interface::InterfaceMotion;
+use crate::body::{Body, BodyKinematics};
 use crate::error::{Error, Result};
 use crate::model::variables::{FixedKey, InterfaceQuantity};
 use crate::model::{InterfaceKind, Target, VariableType};
-use crate::solver::generalized_alpha::{self};
+use crate::solver::generalized_alpha::{self, DynamicState, FreeNodes};
 use nalgebra::{Matrix3, Vector3};
 
 /// Outputs computed once per state, on the first read.
@@ -47,92 +48,16 @@ impl Slave {
         let kin =
             generalized_alpha::residual(body, &model.free, state, &loads, &mut model.workspace);
         let residual = generalized_alpha::last_residual(&model.workspace);
-
-        // Body outputs (DESIGN.md section 4).
-        let m = body.total_mass;
-        let (mut com, mut vcom, mut acom) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-        for (i, &mi) in body.mass_row_sums.iter().enumerate() {
-            com += mi * node(&state.position, i);
-            vcom += mi * node(&state.velocity, i);
-            acom += mi * node(&state.acceleration, i);
-        }
-        com /= m;
-        vcom /= m;
-        acom /= m;
-        self.outputs.body_acceleration = acom.into();
-        let (mut angular, mut kinetic) = (Vector3::zeros(), 0.0);
-        let momentum = &mut self.outputs.momentum;
-        momentum.resize(state.velocity.len(), 0.0); // sized by `finish_model`: no allocation
-        body.mass_times(&state.velocity, momentum);
-        for i in 0..body.node_count() {
-            let mv = node(momentum, i);
-            angular += (node(&state.position, i) - body.unit(i) * com).cross(&mv);
-            kinetic += 0.5 * node(&state.velocity, i).dot(&mv);
-        }
-        let r = kin.frame.rotation;
-        let omega = r * kin.angular_velocity_body;
-        let out = &mut self.outputs.body;
-        out[0..3].copy_from_slice(com.as_slice());
-        for (k, value) in out[3..12].iter_mut().enumerate() {
-            *value = r[(k / 3, k % 3)];
-        }
-        out[12..15].copy_from_slice(vcom.as_slice());
-        out[15..18].copy_from_slice(omega.as_slice());
-        out[18..21].copy_from_slice((m * vcom).as_slice());
-        out[21..24].copy_from_slice(angular.as_slice());
-        out[24] = kinetic;
-        out[25] = match &body.full {
-            Some(full) => full.strain_energy(&state.position),
-            None => kin.strain_energy,
-        };
-
+        body_outputs(body, state, &kin, &mut self.outputs);
         for (k, interface) in self.interfaces.iter().enumerate() {
-            let out = &mut self.outputs.interfaces[k];
-            match interface.kind {
-                InterfaceKind::Pin | InterfaceKind::Hinge => {
-                    // The constraint load on the body is −Cᵀλ: per point constraint a force −λ_k
-                    // at its centroid c_k; the torque is taken about the reference point.
-                    let p = interface
-                        .set
-                        .motion(&state.position, &state.velocity, &state.acceleration)
-                        .position;
-                    let (mut force, mut torque) = (Vector3::zeros(), Vector3::zeros());
-                    let first = interface.first_constraint;
-                    for (j, constraint) in model.free.constraints
-                        [first..first + interface.point_constraints.len()]
-                        .iter()
-                        .enumerate()
-                    {
-                        let m = &state.multipliers[3 * (first + j)..3 * (first + j) + 3];
-                        let f = -Vector3::new(m[0], m[1], m[2]);
-                        force += f;
-                        torque += (constraint.centroid(&state.position) - p).cross(&f);
-                    }
-                    out[0..3].copy_from_slice(force.as_slice());
-                    out[3..6].copy_from_slice(torque.as_slice());
-                }
-                InterfaceKind::Fixed | InterfaceKind::Motion => {
-                    // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
-                    let (f, t) = interface.set.resultant(&state.position, residual);
-                    out[0..3].copy_from_slice(f.as_slice());
-                    out[3..6].copy_from_slice(t.as_slice());
-                }
-                InterfaceKind::Force => {
-                    out[0..6].copy_from_slice(&dynamics.loads[k][0..6]);
-                    let m: InterfaceMotion =
-                        interface
-                            .set
-                            .motion(&state.position, &state.velocity, &state.acceleration);
-                    out[6..9].copy_from_slice(m.position.as_slice());
-                    for (j, value) in out[9..18].iter_mut().enumerate() {
-                        *value = m.rotation[(j / 3, j % 3)];
-                    }
-                    out[18..21].copy_from_slice(m.velocity.as_slice());
-                    out[21..24].copy_from_slice(m.angular_velocity.as_slice());
-                    out[24..27].copy_from_slice(m.acceleration.as_slice());
-                    out[27..30].copy_from_slice(m.angular_acceleration.as_slice());
-                }
-            }
+            interface_outputs(
+                interface,
+                &model.free,
+                state,
+                residual,
+                &dynamics.loads[k],
+                &mut self.outputs.interfaces[k],
+            );
         }
         let finite = self.outputs.body.iter().all(|x| x.is_finite())
             && self.outputs.body_acceleration.iter().all(|x| x.is_finite())
@@ -258,6 +183,106 @@ impl Slave {
                 "{} (value reference {vr}) has no derivative of order {order} (available: interface position and rotation up to order 2, velocity and angularVelocity order 1; body.position up to order 2, body.velocity, body.linearMomentum and body.rotation order 1)",
                 name(self)
             ))),
+        }
+    }
+}
+
+/// The body outputs (docs/fmu.md, "Variables") of `state`: centre of mass, co-moving frame,
+/// momenta about the centre of mass, kinetic and strain energy; and the centre of mass's
+/// acceleration (for output derivatives).
+fn body_outputs(body: &Body, state: &DynamicState, kin: &BodyKinematics, outputs: &mut Outputs) {
+    let m = body.total_mass;
+    let (mut com, mut vcom, mut acom) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+    for (i, &mi) in body.mass_row_sums.iter().enumerate() {
+        com += mi * node(&state.position, i);
+        vcom += mi * node(&state.velocity, i);
+        acom += mi * node(&state.acceleration, i);
+    }
+    com /= m;
+    vcom /= m;
+    acom /= m;
+    outputs.body_acceleration = acom.into();
+    let (mut angular, mut kinetic) = (Vector3::zeros(), 0.0);
+    let momentum = &mut outputs.momentum;
+    momentum.resize(state.velocity.len(), 0.0); // sized by `finish_model`: no allocation
+    body.mass_times(&state.velocity, momentum);
+    for i in 0..body.node_count() {
+        let mv = node(momentum, i);
+        angular += (node(&state.position, i) - body.unit(i) * com).cross(&mv);
+        kinetic += 0.5 * node(&state.velocity, i).dot(&mv);
+    }
+    let r = kin.frame.rotation;
+    let omega = r * kin.angular_velocity_body;
+    let out = &mut outputs.body;
+    out[0..3].copy_from_slice(com.as_slice());
+    for (k, value) in out[3..12].iter_mut().enumerate() {
+        *value = r[(k / 3, k % 3)];
+    }
+    out[12..15].copy_from_slice(vcom.as_slice());
+    out[15..18].copy_from_slice(omega.as_slice());
+    out[18..21].copy_from_slice((m * vcom).as_slice());
+    out[21..24].copy_from_slice(angular.as_slice());
+    out[24] = kinetic;
+    out[25] = match &body.full {
+        Some(full) => full.strain_energy(&state.position),
+        None => kin.strain_energy,
+    };
+}
+
+/// The outputs of one interface (value-reference slot order) in `state`, with `residual` the
+/// residual of the equations of motion (the reactions of supports and motion interfaces) and
+/// `load` the inputs the state's accelerations belong to.
+fn interface_outputs(
+    interface: &Interface,
+    free: &FreeNodes,
+    state: &DynamicState,
+    residual: &[f64],
+    load: &Inputs,
+    out: &mut Inputs,
+) {
+    match interface.kind {
+        InterfaceKind::Pin | InterfaceKind::Hinge => {
+            // The constraint load on the body is −Cᵀλ: per point constraint a force −λ_k
+            // at its centroid c_k; the torque is taken about the reference point.
+            let p = interface
+                .set
+                .motion(&state.position, &state.velocity, &state.acceleration)
+                .position;
+            let (mut force, mut torque) = (Vector3::zeros(), Vector3::zeros());
+            let first = interface.first_constraint;
+            for (j, constraint) in free.constraints
+                [first..first + interface.point_constraints.len()]
+                .iter()
+                .enumerate()
+            {
+                let m = &state.multipliers[3 * (first + j)..3 * (first + j) + 3];
+                let f = -Vector3::new(m[0], m[1], m[2]);
+                force += f;
+                torque += (constraint.centroid(&state.position) - p).cross(&f);
+            }
+            out[0..3].copy_from_slice(force.as_slice());
+            out[3..6].copy_from_slice(torque.as_slice());
+        }
+        InterfaceKind::Fixed | InterfaceKind::Motion => {
+            // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
+            let (f, t) = interface.set.resultant(&state.position, residual);
+            out[0..3].copy_from_slice(f.as_slice());
+            out[3..6].copy_from_slice(t.as_slice());
+        }
+        InterfaceKind::Force => {
+            out[0..6].copy_from_slice(&load[0..6]);
+            let m: InterfaceMotion =
+                interface
+                    .set
+                    .motion(&state.position, &state.velocity, &state.acceleration);
+            out[6..9].copy_from_slice(m.position.as_slice());
+            for (j, value) in out[9..18].iter_mut().enumerate() {
+                *value = m.rotation[(j / 3, j % 3)];
+            }
+            out[18..21].copy_from_slice(m.velocity.as_slice());
+            out[21..24].copy_from_slice(m.angular_velocity.as_slice());
+            out[24..27].copy_from_slice(m.acceleration.as_slice());
+            out[27..30].copy_from_slice(m.angular_acceleration.as_slice());
         }
     }
 }

@@ -25,7 +25,38 @@ impl Slave {
         current_communication_point: f64,
         communication_step_size: f64,
     ) -> Result<()> {
-        let big_h = communication_step_size;
+        let (t_c, big_h) = (current_communication_point, communication_step_size);
+        let (n, h) = self.internal_steps(t_c, big_h)?;
+        self.prepare_step(t_c, h)?;
+        // Held inputs that jump at a communication point are not restarted from consistent
+        // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
+        // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
+        // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
+        // H = 2e-4 s). Input derivatives give continuous loads instead.
+        let mut result = Ok(());
+        for i in 0..n {
+            result = self.internal_step(t_c, big_h, i, n, h);
+            if result.is_err() {
+                break;
+            }
+        }
+        let dynamics = self.dynamics.as_mut().unwrap();
+        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
+            result = Err(Error::discard("the step produced non-finite positions"));
+        }
+        match result {
+            Ok(()) => {
+                self.finish_step(t_c, big_h);
+                Ok(())
+            }
+            Err(e) => Err(self.roll_back(t_c, big_h, e)),
+        }
+    }
+
+    /// The number `n` and length `h` of the equal internal steps of a communication step from
+    /// `t_c` by `big_h`, no longer than `solver.stepSize` (and the explicit scheme's stable
+    /// step), after checking the request against the FMU's time.
+    fn internal_steps(&self, t_c: f64, big_h: f64) -> Result<(usize, f64)> {
         if !(big_h.is_finite() && big_h > 0.0) {
             return Err(Error::invalid_value(
                 "communicationStepSize",
@@ -38,12 +69,10 @@ impl Slave {
             return Err(Error::new("doStep before the body was initialized"));
         }
         let slack = 1e-5 * big_h + 4.0 * f64::EPSILON * t.abs();
-        if !current_communication_point.is_finite()
-            || (current_communication_point - t).abs() > slack
-        {
+        if !t_c.is_finite() || (t_c - t).abs() > slack {
             return Err(Error::invalid_value(
                 "currentCommunicationPoint",
-                current_communication_point,
+                t_c,
                 &format!("does not match the FMU's time {t} (restore a state with fmi2SetFMUstate to go back)"),
             ));
         }
@@ -60,10 +89,14 @@ impl Slave {
                 "needs more than 1e9 internal steps of solver.stepSize",
             ));
         }
-        let h = big_h / substeps;
-        let n = substeps as usize;
+        Ok((substeps as usize, big_h / substeps))
+    }
+
+    /// Everything a communication step needs before its first internal step: the driving
+    /// frames, the factorization for `h` (on a cache miss; an error here leaves the state), the
+    /// terms in force, the geometric stiffness of the current prestress and the backup.
+    fn prepare_step(&mut self, t_c: f64, h: f64) -> Result<()> {
         self.update_driving_frames()?;
-        // Factorise (on a cache miss) before anything changes: an error here leaves the state.
         self.matrix_index(h)?;
         let model = self.model.as_mut().expect("matrix_index built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
@@ -90,85 +123,74 @@ impl Slave {
         }
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
-        dynamics.state.time = current_communication_point;
-        // Held inputs that jump at a communication point are not restarted from consistent
-        // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
-        // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
-        // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
-        // H = 2e-4 s). Input derivatives give continuous loads instead.
-        let mut result = Ok(());
-        for i in 0..n {
-            result = self.internal_step(current_communication_point, big_h, i, n, h);
-            if result.is_err() {
-                break;
-            }
-        }
+        dynamics.state.time = t_c;
+        Ok(())
+    }
+
+    /// After a successful communication step: the time, the loads the end state's accelerations
+    /// belong to (the inputs extrapolated to `t_c + H`), the strain watch and the results.
+    fn finish_step(&mut self, t_c: f64, big_h: f64) {
         let dynamics = self.dynamics.as_mut().unwrap();
-        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
-            result = Err(Error::discard("the step produced non-finite positions"));
+        dynamics.state.time = t_c + big_h;
+        dynamics.loads.clone_from(&self.inputs);
+        for ((load, d), age) in dynamics
+            .loads
+            .iter_mut()
+            .zip(&self.input_derivatives)
+            .zip(&self.input_ages)
+        {
+            extrapolate(load, d, age + big_h);
         }
-        match result {
-            Ok(()) => {
-                dynamics.state.time = current_communication_point + big_h;
-                // The end state's accelerations belong to the inputs extrapolated to t_c + H.
-                dynamics.loads.clone_from(&self.inputs);
-                for ((load, d), age) in dynamics
-                    .loads
-                    .iter_mut()
-                    .zip(&self.input_derivatives)
-                    .zip(&self.input_ages)
-                {
-                    extrapolate(load, d, age + big_h);
-                }
-                dynamics.gravity = self.parameters.gravity;
-                self.outputs.valid = false;
-                // The small-strain watch: a message when ‖∇ū‖ crosses the threshold (once per
-                // crossing; again after it fell below half of it).
-                let model = self.model.as_mut().expect("the model exists after a step");
-                if let Some((monitor, above)) = &mut model.strain_monitor {
-                    let g = monitor
-                        .largest_gradient(model.workspace.force_scratch().local_deformation());
-                    if g > DEFAULT_THRESHOLD && !*above {
-                        *above = true;
-                        self.events.push(LogEvent {
-                            category: "logEvents",
-                            message: format!(
-                                "warning: at t = {} the deformation gradient in the co-moving frame reached ‖∇ū‖ ≈ {g:.3} (> {DEFAULT_THRESHOLD}): beyond the small-strain range of the reduced strain the results lose accuracy without other signs; use model.frames > 1 for large bending or model.formulation = full",
-                                current_communication_point + big_h
-                            ),
-                        });
-                    } else if g < 0.5 * DEFAULT_THRESHOLD && *above {
-                        *above = false;
-                        self.events.push(LogEvent {
-                            category: "logEvents",
-                            message: format!(
-                                "at t = {} ‖∇ū‖ ≈ {g:.3} is back within the small-strain range",
-                                current_communication_point + big_h
-                            ),
-                        });
-                    }
-                }
-                if self.results.is_some() {
-                    self.write_results();
-                }
-                Ok(())
-            }
-            Err(e) => {
-                dynamics.state.copy_from(self.backup.as_ref().unwrap());
-                self.outputs.valid = false;
-                let kind = e.kind;
-                let message = format!(
-                    "doStep from t = {current_communication_point} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {current_communication_point}{}",
-                    e.message,
-                    if kind == ErrorKind::Discard {
-                        "; retry with a smaller communication step (fmi2SetFMUstate to a saved state, or fmi2Reset)"
-                    } else {
-                        ""
-                    }
-                );
-                Err(Error { kind, message })
-            }
+        dynamics.gravity = self.parameters.gravity;
+        self.outputs.valid = false;
+        self.watch_strain(t_c + big_h);
+        if self.results.is_some() {
+            self.write_results();
         }
+    }
+
+    /// The small-strain watch: a message when `‖∇ū‖` crosses the threshold at time `t` (once
+    /// per crossing; again after it fell below half of it).
+    fn watch_strain(&mut self, t: f64) {
+        let model = self.model.as_mut().expect("the model exists after a step");
+        let Some((monitor, above)) = &mut model.strain_monitor else {
+            return;
+        };
+        let g = monitor.largest_gradient(model.workspace.force_scratch().local_deformation());
+        if g > DEFAULT_THRESHOLD && !*above {
+            *above = true;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!(
+                    "warning: at t = {t} the deformation gradient in the co-moving frame reached ‖∇ū‖ ≈ {g:.3} (> {DEFAULT_THRESHOLD}): beyond the small-strain range of the reduced strain the results lose accuracy without other signs; use model.frames > 1 for large bending or model.formulation = full"
+                ),
+            });
+        } else if g < 0.5 * DEFAULT_THRESHOLD && *above {
+            *above = false;
+            self.events.push(LogEvent {
+                category: "logEvents",
+                message: format!("at t = {t} ‖∇ū‖ ≈ {g:.3} is back within the small-strain range"),
+            });
+        }
+    }
+
+    /// After a failed communication step: the state back at `t_c`, and the error `e` worded
+    /// for the importer.
+    fn roll_back(&mut self, t_c: f64, big_h: f64, e: Error) -> Error {
+        let dynamics = self.dynamics.as_mut().unwrap();
+        dynamics.state.copy_from(self.backup.as_ref().unwrap());
+        self.outputs.valid = false;
+        let kind = e.kind;
+        let message = format!(
+            "doStep from t = {t_c} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {t_c}{}",
+            e.message,
+            if kind == ErrorKind::Discard {
+                "; retry with a smaller communication step (fmi2SetFMUstate to a saved state, or fmi2Reset)"
+            } else {
+                ""
+            }
+        );
+        Error { kind, message }
     }
 
     /// Internal step `i` of `n` (of length `h`) of the communication step from `t_c` by `big_h`.
