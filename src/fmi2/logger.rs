@@ -10,15 +10,7 @@ use super::types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
 use crate::model::variables::LOG_CATEGORIES;
 use std::ffi::CString;
 
-/// Log category names used by the FMI layer (all declared in `<LogCategories>`).
-pub mod category {
-    pub const EVENTS: &str = "logEvents";
-    pub const SOLVER: &str = "logSolver";
-    pub const WARNING: &str = "logStatusWarning";
-    pub const DISCARD: &str = "logStatusDiscard";
-    pub const ERROR: &str = "logStatusError";
-    pub const FATAL: &str = "logStatusFatal";
-}
+pub use crate::model::category;
 
 /// The status category that always reaches the logger for a status worse than OK.
 pub fn category_of(status: fmi2Status) -> &'static str {

@@ -10,3 +10,14 @@ pub use variables::{Causality, Target, Variability, Variable, VariableTable, Var
 
 /// The `modelIdentifier` of the FMU: the shared library is `binaries/linux64/flexbody.so`.
 pub const MODEL_IDENTIFIER: &str = "flexbody";
+
+/// Log category names (all declared in `<LogCategories>`, from `modelDescription/variables.json`):
+/// the debug categories of the slave's events and the status categories of the FMI layer.
+pub mod category {
+    pub const EVENTS: &str = "logEvents";
+    pub const SOLVER: &str = "logSolver";
+    pub const WARNING: &str = "logStatusWarning";
+    pub const DISCARD: &str = "logStatusDiscard";
+    pub const ERROR: &str = "logStatusError";
+    pub const FATAL: &str = "logStatusFatal";
+}

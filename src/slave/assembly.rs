@@ -13,6 +13,8 @@ use crate::body::{Body, BodyOptions, NodeSet, Patches, Reduction};
 use crate::error::{Error, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
+use crate::linalg::SymmetricCsr;
+use crate::model::category;
 use crate::model::InterfaceKind;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
@@ -122,7 +124,7 @@ pub(super) fn cached_factorization<T>(
     let started = std::time::Instant::now();
     let matrix = factorise()?;
     events.push(LogEvent {
-        category: "logEvents",
+        category: category::EVENTS,
         message: describe(&matrix, started.elapsed().as_secs_f64()),
     });
     if cache.len() >= MATRIX_CACHE_SIZE {
@@ -130,6 +132,14 @@ pub(super) fn cached_factorization<T>(
     }
     cache.push(matrix);
     Ok(cache.len() - 1)
+}
+
+/// The matrices of the reference mesh: positions `X` (flat `3N`), the scalar mass matrix `Ms`
+/// and the small-strain stiffness `K` (docs/formulation.md, "mass_matrix", "stiffness_matrix").
+struct MeshMatrices {
+    reference: Vec<f64>,
+    mass_matrix: SymmetricCsr,
+    stiffness_matrix: SymmetricCsr,
 }
 
 impl Slave {
@@ -141,30 +151,11 @@ impl Slave {
         }
         let p = &self.parameters;
         p.material.validate()?;
+        self.check_regions()?;
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
         // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
         // Material regions: each element's material (the body's outside every region).
         let regions = &self.body_file.regions;
-        if !regions.is_empty() {
-            let unsupported = if p.formulation == FORMULATION_FULL {
-                Some("model.formulation = full")
-            } else if p.stiffening != 1 {
-                Some("model.stiffening other than none")
-            } else if p.frames > 1 {
-                Some("model.frames > 1")
-            } else if !p.output_directory.is_empty() {
-                Some("output.directory (the stress output uses one material)")
-            } else {
-                None
-            };
-            if let Some(what) = unsupported {
-                return Err(Error::new(format!(
-                    "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
-                    regions[0].name,
-                    if regions.len() > 1 { ", ..." } else { "" }
-                )));
-            }
-        }
         let element_material = |e: usize| match self.element_regions[e] {
             Some(k) => IsotropicMaterial {
                 youngs_modulus: regions[k].youngs_modulus,
@@ -175,102 +166,150 @@ impl Slave {
         };
         let density = |e: usize| element_material(e).density;
         let lumped = fem::lumped_masses_of(&self.mesh, &density);
+        let matrices = MeshMatrices {
+            reference,
+            mass_matrix: fem::scalar_mass_matrix_of(&self.mesh, &density),
+            stiffness_matrix: fem::stiffness_matrix_of(&self.mesh, &element_material),
+        };
         let options = BodyOptions {
             nonlinear_forces: p.nonlinear_forces,
             damping_alpha: p.damping_alpha,
             damping_beta: p.damping_beta,
         };
-        let mass_matrix = fem::scalar_mass_matrix_of(&self.mesh, &density);
-        let stiffness_matrix = fem::stiffness_matrix_of(&self.mesh, &element_material);
-        if p.modes > 0 {
-            self.check_reducible()?;
-            let p = &self.parameters;
-            let started = std::time::Instant::now();
-            let (boundary, loaded): (Vec<&NodeSet>, Vec<&NodeSet>) = {
-                let sets = |kinds: &[InterfaceKind]| {
-                    self.interfaces
-                        .iter()
-                        .filter(|i| kinds.contains(&i.kind))
-                        .map(|i| &i.set)
-                        .collect::<Vec<_>>()
-                };
-                (
-                    sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
-                    sets(&[InterfaceKind::Force]),
-                )
-            };
-            let reduction = Reduction::new(
-                &reference,
-                &mass_matrix,
-                &stiffness_matrix,
-                &lumped,
-                &boundary,
-                &loaded,
-                p.modes as usize,
-            )?;
-            let frequencies: Vec<String> = reduction
-                .mode_eigenvalues
-                .iter()
-                .map(|l| format!("{:.4}", l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)))
-                .collect();
-            self.events.push(LogEvent {
-                category: "logEvents",
-                message: format!(
-                    "reduced the body (model.modes = {}): {} nodes → {} fields ({} coordinates); fixed-interface mode frequencies [{}] Hz ({:.3} s)",
-                    p.modes,
-                    reduction.node_count,
-                    reduction.field_count,
-                    3 * reduction.field_count,
-                    frequencies.join(", "),
-                    started.elapsed().as_secs_f64()
-                ),
-            });
-            let mut held = reduction.held.iter();
-            for interface in &mut self.interfaces {
-                let holds = matches!(interface.kind, InterfaceKind::Fixed | InterfaceKind::Motion);
-                let coordinates = if holds {
-                    held.next().cloned().unwrap_or_default()
-                } else {
-                    Vec::new()
-                };
-                interface.set.set_reduction(Some((&reduction, coordinates)));
-            }
-            let mut clamped = vec![false; reduction.field_count];
-            for interface in &self.interfaces {
-                if matches!(interface.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
-                    for k in interface.set.held_indices() {
-                        clamped[k] = true;
-                    }
-                }
-            }
-            let body = Body::reduced(reduction, options);
-            return self.finish_model(key, body, clamped, &lumped);
+        let (body, clamped) = if p.modes > 0 {
+            self.reduced_body(&matrices, &lumped, options)?
+        } else {
+            (
+                self.mesh_body(matrices, &lumped, options)?,
+                self.clamped.clone(),
+            )
+        };
+        self.finish_model(key, body, clamped, &lumped)
+    }
+
+    /// Material regions are supported by the reduced-strain body with one frame and no
+    /// stiffening only: anything else is an error naming what is not supported.
+    fn check_regions(&self) -> Result<()> {
+        let (p, regions) = (&self.parameters, &self.body_file.regions);
+        if regions.is_empty() {
+            return Ok(());
         }
+        let unsupported = if p.formulation == FORMULATION_FULL {
+            Some("model.formulation = full")
+        } else if p.stiffening != STIFFENING_NONE {
+            Some("model.stiffening other than none")
+        } else if p.frames > 1 {
+            Some("model.frames > 1")
+        } else if !p.output_directory.is_empty() {
+            Some("output.directory (the stress output uses one material)")
+        } else {
+            None
+        };
+        match unsupported {
+            Some(what) => Err(Error::new(format!(
+                "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
+                regions[0].name,
+                if regions.len() > 1 { ", ..." } else { "" }
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The body on the whole mesh: one co-moving frame, several (`model.frames`), or the full
+    /// formulation.
+    fn mesh_body(
+        &mut self,
+        matrices: MeshMatrices,
+        lumped: &[f64],
+        options: BodyOptions,
+    ) -> Result<Body> {
         for interface in &mut self.interfaces {
             interface.set.set_reduction(None);
         }
         let p = &self.parameters;
         let body = Body::new(
-            reference,
-            mass_matrix,
-            stiffness_matrix,
-            lumped.clone(),
+            matrices.reference,
+            matrices.mass_matrix,
+            matrices.stiffness_matrix,
+            lumped.to_vec(),
             options,
         );
-        let body = if p.formulation == FORMULATION_FULL {
+        Ok(if p.formulation == FORMULATION_FULL {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
         } else if p.frames > 1 {
             body.with_patches(Patches::along_principal_axis(
                 &self.mesh,
                 &p.material,
-                &lumped,
+                lumped,
                 p.frames as usize,
             )?)
         } else {
             body
+        })
+    }
+
+    /// The reduced body (`model.modes > 0`, docs/formulation.md, "The reduced body") and which
+    /// of its fields are held by supports and motion interfaces; the interfaces' node sets are
+    /// expressed in its fields.
+    fn reduced_body(
+        &mut self,
+        matrices: &MeshMatrices,
+        lumped: &[f64],
+        options: BodyOptions,
+    ) -> Result<(Body, Vec<bool>)> {
+        self.check_reducible()?;
+        let p = &self.parameters;
+        let started = std::time::Instant::now();
+        let sets = |kinds: &[InterfaceKind]| {
+            self.interfaces
+                .iter()
+                .filter(|i| kinds.contains(&i.kind))
+                .map(|i| &i.set)
+                .collect::<Vec<&NodeSet>>()
         };
-        let clamped = self.clamped.clone();
-        self.finish_model(key, body, clamped, &lumped)
+        let reduction = Reduction::new(
+            &matrices.reference,
+            &matrices.mass_matrix,
+            &matrices.stiffness_matrix,
+            lumped,
+            &sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
+            &sets(&[InterfaceKind::Force]),
+            p.modes as usize,
+        )?;
+        let frequencies: Vec<String> = reduction
+            .mode_eigenvalues
+            .iter()
+            .map(|l| format!("{:.4}", l.max(0.0).sqrt() / (2.0 * std::f64::consts::PI)))
+            .collect();
+        self.events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "reduced the body (model.modes = {}): {} nodes → {} fields ({} coordinates); fixed-interface mode frequencies [{}] Hz ({:.3} s)",
+                p.modes,
+                reduction.node_count,
+                reduction.field_count,
+                3 * reduction.field_count,
+                frequencies.join(", "),
+                started.elapsed().as_secs_f64()
+            ),
+        });
+        let mut held = reduction.held.iter();
+        let mut clamped = vec![false; reduction.field_count];
+        for interface in &mut self.interfaces {
+            let holds = matches!(interface.kind, InterfaceKind::Fixed | InterfaceKind::Motion);
+            let coordinates = if holds {
+                held.next().cloned().unwrap_or_default()
+            } else {
+                Vec::new()
+            };
+            interface.set.set_reduction(Some((&reduction, coordinates)));
+            if holds {
+                for k in interface.set.held_indices() {
+                    clamped[k] = true;
+                }
+            }
+        }
+        Ok((Body::reduced(reduction, options), clamped))
     }
 
     /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
@@ -319,30 +358,18 @@ impl Slave {
         }
     }
 
-    /// The solver's side of a model build: free nodes, constraints, stiffening, the explicit
-    /// scheme, the logs.
+    /// The solver's side of a model build: free nodes, constraints, stiffening, `model.auto`'s
+    /// indicators, the schemes, the logs.
     pub(super) fn finish_model(
         &mut self,
         key: ModelKey,
-        body: Body,
+        mut body: Body,
         clamped: Vec<bool>,
         lumped: &[f64],
     ) -> Result<()> {
-        let p = &self.parameters;
         let started = std::time::Instant::now();
-        let mut free = FreeNodes::new(&body, &clamped);
-        for (k, interface) in self.interfaces.iter_mut().enumerate() {
-            interface.first_constraint = free.constraints.len();
-            for (nodes, weights) in &interface.point_constraints {
-                // The target is set where the body is placed (ensure_initial_state).
-                free.add_point_constraint(
-                    &self.body_file.interfaces[k].name,
-                    nodes,
-                    weights,
-                    Vector3::zeros(),
-                )?;
-            }
-        }
+        let free = self.constrained_free_nodes(&body, &clamped)?;
+        let p = &self.parameters;
         let mut workspace =
             StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
         let stiffening = match p.stiffening {
@@ -358,58 +385,14 @@ impl Slave {
         if stiffening.is_some() {
             workspace.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
         }
-        // model.auto: indicators for the allowed terms of the one-frame reduced-strain body
-        // (patches and the full formulation have no switchable terms: forced as given).
         let allowed = Features {
             nonlinear_forces: p.nonlinear_forces,
             stiffening: stiffening.is_some(),
         };
-        // The reduced body is forced as given too (its indicators would need the expanded mesh).
-        let single = p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
-        let indicators = (p.auto && single && (allowed.nonlinear_forces || allowed.stiffening))
-            .then(|| {
-                FeatureIndicators::new(
-                    &self.mesh,
-                    &body,
-                    &free.nodes,
-                    &free.stiffness,
-                    &free.mass,
-                    !free.clamped.is_empty(),
-                    stiffening.as_ref(),
-                )
-            });
-        let mut body = body;
+        let indicators = self.feature_indicators(&body, &free, stiffening.as_ref(), allowed);
         body.nonlinear_forces_switchable = indicators.is_some() && allowed.nonlinear_forces;
-        if let Some(ind) = &indicators {
-            let verdict = |allowed: bool, estimated: bool, why: &str| {
-                if !allowed {
-                    "not allowed (off)".to_string()
-                } else if estimated {
-                    "allowed, switched per communication step by its indicator".to_string()
-                } else {
-                    format!("allowed, always on ({why})")
-                }
-            };
-            self.events.push(LogEvent {
-                category: "logEvents",
-                message: format!(
-                    "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds solver.tolerance × size = {:.3e} m, off when it stayed below {} of that for one period 2π/ω₁",
-                    verdict(
-                        allowed.nonlinear_forces,
-                        ind.estimates_nonlinear_forces(),
-                        "no estimate for a body without fixed supports or motion interfaces: its spurious moment accumulates"
-                    ),
-                    verdict(allowed.stiffening, ind.estimates_stiffening(), "no estimate"),
-                    ind.first_frequency()
-                        .map_or("not computed".to_string(), |w| format!("{w:.4e} rad/s")),
-                    feature_indicators::SAFETY,
-                    p.tolerance * self.size,
-                    feature_indicators::HYSTERESIS
-                ),
-            });
-        }
         self.events.push(LogEvent {
-            category: "logEvents",
+            category: category::EVENTS,
             message: format!(
                 "assembled the body: {} {}, {} elements, {} DOF ({} free), nnz(K) = {}, mass {:.6e} kg ({:.3} s)",
                 body.node_count(),
@@ -422,51 +405,11 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
-        let explicit = if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
-            let scheme = CentralDifference::new(&body, lumped, &free)?;
-            self.events.push(LogEvent {
-                category: "logEvents",
-                message: format!(
-                    "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
-                    scheme.highest_frequency,
-                    scheme.stable_step(),
-                    crate::solver::central_difference::STABILITY_MARGIN,
-                    if p.step_size > scheme.stable_step() {
-                        format!(
-                            "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
-                            p.step_size
-                        )
-                    } else {
-                        String::new()
-                    }
-                ),
-            });
-            Some(scheme)
-        } else {
-            None
-        };
+        let explicit = self.explicit_scheme(&body, lumped, &free)?;
+        let radau = self.radau_model(&body, &free)?;
+        let p = &self.parameters;
         let monitored =
             p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
-        let radau = if p.integrator == INTEGRATOR_RADAU {
-            // Radau's constant matrices hold the rotated small-strain stiffness: no tangent for
-            // the full formulation.
-            if p.formulation == FORMULATION_FULL {
-                return Err(Error::new(
-                    "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
-                ));
-            }
-            Some(RadauModel {
-                tableau: RadauIIA::new(),
-                matrices: Vec::new(),
-                workspace: RadauWorkspace::with_anderson_depth(
-                    &body,
-                    &free,
-                    p.anderson_depth as usize,
-                ),
-            })
-        } else {
-            None
-        };
         self.model = Some(Model {
             key,
             radau,
@@ -490,6 +433,130 @@ impl Slave {
         let size = self.model.as_ref().map_or(0, |m| m.body.reference.len());
         self.outputs.momentum = vec![0.0; size];
         Ok(())
+    }
+
+    /// The free nodes of `body` (all but the `clamped` ones) with the point constraints of the
+    /// pins and hinges; each interface learns where its constraints start.
+    fn constrained_free_nodes(&mut self, body: &Body, clamped: &[bool]) -> Result<FreeNodes> {
+        let mut free = FreeNodes::new(body, clamped);
+        for (k, interface) in self.interfaces.iter_mut().enumerate() {
+            interface.first_constraint = free.constraints.len();
+            for (nodes, weights) in &interface.point_constraints {
+                // The target is set where the body is placed (ensure_initial_state).
+                free.add_point_constraint(
+                    &self.body_file.interfaces[k].name,
+                    nodes,
+                    weights,
+                    Vector3::zeros(),
+                )?;
+            }
+        }
+        Ok(free)
+    }
+
+    /// `model.auto`'s indicators for the allowed terms of the one-frame reduced-strain body on
+    /// the whole mesh (patches, the full formulation and the reduced body have no switchable
+    /// terms: forced as given), with the decision logged.
+    fn feature_indicators(
+        &mut self,
+        body: &Body,
+        free: &FreeNodes,
+        stiffening: Option<&Stiffening>,
+        allowed: Features,
+    ) -> Option<FeatureIndicators> {
+        let p = &self.parameters;
+        let single = p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
+        if !(p.auto && single && (allowed.nonlinear_forces || allowed.stiffening)) {
+            return None;
+        }
+        let ind = FeatureIndicators::new(
+            &self.mesh,
+            body,
+            &free.nodes,
+            &free.stiffness,
+            &free.mass,
+            !free.clamped.is_empty(),
+            stiffening,
+        );
+        let verdict = |allowed: bool, estimated: bool, why: &str| {
+            if !allowed {
+                "not allowed (off)".to_string()
+            } else if estimated {
+                "allowed, switched per communication step by its indicator".to_string()
+            } else {
+                format!("allowed, always on ({why})")
+            }
+        };
+        self.events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds solver.tolerance × size = {:.3e} m, off when it stayed below {} of that for one period 2π/ω₁",
+                verdict(
+                    allowed.nonlinear_forces,
+                    ind.estimates_nonlinear_forces(),
+                    "no estimate for a body without fixed supports or motion interfaces: its spurious moment accumulates"
+                ),
+                verdict(allowed.stiffening, ind.estimates_stiffening(), "no estimate"),
+                ind.first_frequency()
+                    .map_or("not computed".to_string(), |w| format!("{w:.4e} rad/s")),
+                feature_indicators::SAFETY,
+                p.tolerance * self.size,
+                feature_indicators::HYSTERESIS
+            ),
+        });
+        Some(ind)
+    }
+
+    /// The central-difference scheme (`solver.integrator = centralDifference`) with its stable
+    /// step logged, else `None`.
+    fn explicit_scheme(
+        &mut self,
+        body: &Body,
+        lumped: &[f64],
+        free: &FreeNodes,
+    ) -> Result<Option<CentralDifference>> {
+        let p = &self.parameters;
+        if p.integrator != INTEGRATOR_CENTRAL_DIFFERENCE {
+            return Ok(None);
+        }
+        let scheme = CentralDifference::new(body, lumped, free)?;
+        self.events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
+                scheme.highest_frequency,
+                scheme.stable_step(),
+                crate::solver::central_difference::STABILITY_MARGIN,
+                if p.step_size > scheme.stable_step() {
+                    format!(
+                        "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
+                        p.step_size
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+        });
+        Ok(Some(scheme))
+    }
+
+    /// Radau IIA's part of the model (`solver.integrator = radauIIA`), else `None`. Its constant
+    /// matrices hold the rotated small-strain stiffness: no tangent for the full formulation.
+    fn radau_model(&self, body: &Body, free: &FreeNodes) -> Result<Option<RadauModel>> {
+        let p = &self.parameters;
+        if p.integrator != INTEGRATOR_RADAU {
+            return Ok(None);
+        }
+        if p.formulation == FORMULATION_FULL {
+            return Err(Error::new(
+                "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+            ));
+        }
+        Ok(Some(RadauModel {
+            tableau: RadauIIA::new(),
+            matrices: Vec::new(),
+            workspace: RadauWorkspace::with_anderson_depth(body, free, p.anderson_depth as usize),
+        }))
     }
 
     /// Index of the factorization for internal step `h` in the cache (factorising on a miss and

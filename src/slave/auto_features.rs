@@ -3,6 +3,7 @@
 use super::assembly::Model;
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
+use crate::model::category;
 
 /// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
 /// finite number: the state's byte form holds finite numbers only).
@@ -55,7 +56,7 @@ pub(super) fn choose_features(
             if next != *active {
                 *active = next;
                 events.push(LogEvent {
-                    category: "logEvents",
+                    category: category::EVENTS,
                     message: if next {
                         format!(
                             "model.auto: at t = {} {name} switched on: estimated effect {e:.3e} m, × {} = {scaled:.3e} m > solver.tolerance × size = {target:.3e} m",

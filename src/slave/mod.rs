@@ -7,6 +7,7 @@ use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
 use crate::fem::{self};
 use crate::mesh::Mesh;
+use crate::model::category;
 use crate::model::model_description::{model_description, ModelInfo};
 use crate::model::variables::{InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
 use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
@@ -16,7 +17,6 @@ use assembly::Model;
 use interfaces::{point_constraints, Interface};
 use nalgebra::Vector3;
 use outputs::Outputs;
-use parameters::read_parameter;
 use results::file_stem;
 use std::path::Path;
 use variables::component_of;
@@ -214,7 +214,7 @@ impl Slave {
         let defaults = Parameters::from_body_file(&body_file);
         for v in variables.iter() {
             if let (Target::Fixed { key, .. }, VariableType::Real) = (v.target, v.ty) {
-                let value = read_parameter(&defaults, key, component_of(v));
+                let value = defaults.real(key, component_of(v));
                 if let Some(value) = value {
                     Parameters::check_real(&v.name, key, value)
                         .map_err(|e| Error::new(format!("body file: {}", e.message)))?;
@@ -350,7 +350,7 @@ impl Slave {
             ) {
                 Ok(writer) => {
                     self.events.push(LogEvent {
-                        category: "logEvents",
+                        category: category::EVENTS,
                         message: format!(
                             "output.directory: writing VTK results to {}",
                             writer.collection_path().display()

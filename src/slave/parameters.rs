@@ -150,67 +150,88 @@ impl Parameters {
 /// What the assembled model depends on (see [`Parameters::model_key`]).
 pub(super) type ModelKey = (IsotropicMaterial, [u64; 3], [bool; 2], [i32; 5]);
 
-/// Value of a Real parameter (`None` for outputs and non-Real keys). Allocation-free.
-pub(super) fn read_parameter(p: &Parameters, key: FixedKey, c: usize) -> Option<f64> {
-    use FixedKey::*;
-    Some(match key {
-        YoungsModulus => p.material.youngs_modulus,
-        PoissonRatio => p.material.poisson_ratio,
-        Density => p.material.density,
-        DampingAlpha => p.damping_alpha,
-        DampingBeta => p.damping_beta,
-        Gravity => p.gravity[c],
-        InitialPosition => p.initial_position[c],
-        InitialRotation => p.initial_rotation[c],
-        InitialVelocity => p.initial_velocity[c],
-        InitialAngularVelocity => p.initial_angular_velocity[c],
-        StepSize => p.step_size,
-        RhoInf => p.rho_inf,
-        Tolerance => p.tolerance,
-        OutputInterval => p.output_interval,
-        _ => return None,
-    })
+/// Where a parameter lives in [`Parameters`]: one of the four FMI types, borrowed shared (`R =
+/// &f64`, ...) or exclusive (`R = &mut f64`, ...).
+pub(super) enum Slot<R, I, B, T> {
+    Real(R),
+    Integer(I),
+    Boolean(B),
+    Text(T),
 }
 
-/// The storage of a Real parameter (`None` for outputs and non-Real keys).
-pub(super) fn write_parameter(p: &mut Parameters, key: FixedKey, c: usize) -> Option<&mut f64> {
-    use FixedKey::*;
-    Some(match key {
-        YoungsModulus => &mut p.material.youngs_modulus,
-        PoissonRatio => &mut p.material.poisson_ratio,
-        Density => &mut p.material.density,
-        DampingAlpha => &mut p.damping_alpha,
-        DampingBeta => &mut p.damping_beta,
-        Gravity => &mut p.gravity[c],
-        InitialPosition => &mut p.initial_position[c],
-        InitialRotation => &mut p.initial_rotation[c],
-        InitialVelocity => &mut p.initial_velocity[c],
-        InitialAngularVelocity => &mut p.initial_angular_velocity[c],
-        StepSize => &mut p.step_size,
-        RhoInf => &mut p.rho_inf,
-        Tolerance => &mut p.tolerance,
-        OutputInterval => &mut p.output_interval,
-        _ => return None,
-    })
+/// A parameter read through [`Parameters::slot`].
+pub(super) type SlotRef<'a> = Slot<&'a f64, &'a i32, &'a bool, &'a String>;
+/// A parameter written through [`Parameters::slot_mut`].
+pub(super) type SlotMut<'a> = Slot<&'a mut f64, &'a mut i32, &'a mut bool, &'a mut String>;
+
+/// The one table from a fixed variable (`key`, component `c`) to its field of [`Parameters`],
+/// written once for the shared and the exclusive borrow (`$($m)?` is `mut` or nothing).
+/// Outputs (the body's) have no slot.
+macro_rules! parameter_slot {
+    ($p:expr, $key:expr, $c:expr $(, $m:ident)?) => {{
+        use FixedKey::*;
+        Some(match $key {
+            YoungsModulus => Slot::Real(&$($m)? $p.material.youngs_modulus),
+            PoissonRatio => Slot::Real(&$($m)? $p.material.poisson_ratio),
+            Density => Slot::Real(&$($m)? $p.material.density),
+            DampingAlpha => Slot::Real(&$($m)? $p.damping_alpha),
+            DampingBeta => Slot::Real(&$($m)? $p.damping_beta),
+            Gravity => Slot::Real(&$($m)? $p.gravity[$c]),
+            InitialPosition => Slot::Real(&$($m)? $p.initial_position[$c]),
+            InitialRotation => Slot::Real(&$($m)? $p.initial_rotation[$c]),
+            InitialVelocity => Slot::Real(&$($m)? $p.initial_velocity[$c]),
+            InitialAngularVelocity => Slot::Real(&$($m)? $p.initial_angular_velocity[$c]),
+            StepSize => Slot::Real(&$($m)? $p.step_size),
+            RhoInf => Slot::Real(&$($m)? $p.rho_inf),
+            Tolerance => Slot::Real(&$($m)? $p.tolerance),
+            OutputInterval => Slot::Real(&$($m)? $p.output_interval),
+            MaxIterations => Slot::Integer(&$($m)? $p.max_iterations),
+            Formulation => Slot::Integer(&$($m)? $p.formulation),
+            Stiffening => Slot::Integer(&$($m)? $p.stiffening),
+            Frames => Slot::Integer(&$($m)? $p.frames),
+            Modes => Slot::Integer(&$($m)? $p.modes),
+            AndersonDepth => Slot::Integer(&$($m)? $p.anderson_depth),
+            Integrator => Slot::Integer(&$($m)? $p.integrator),
+            NonlinearForces => Slot::Boolean(&$($m)? $p.nonlinear_forces),
+            Auto => Slot::Boolean(&$($m)? $p.auto),
+            OutputDirectory => Slot::Text(&$($m)? $p.output_directory),
+            _ => return None,
+        })
+    }};
 }
 
-pub(super) fn read_integer(p: &Parameters, key: FixedKey) -> Option<i32> {
-    match key {
-        FixedKey::MaxIterations => Some(p.max_iterations),
-        FixedKey::Formulation => Some(p.formulation),
-        FixedKey::Stiffening => Some(p.stiffening),
-        FixedKey::Frames => Some(p.frames),
-        FixedKey::Modes => Some(p.modes),
-        FixedKey::AndersonDepth => Some(p.anderson_depth),
-        FixedKey::Integrator => Some(p.integrator),
-        _ => None,
+impl Parameters {
+    /// The field of the fixed variable `key` (component `c`), `None` for outputs.
+    pub(super) fn slot(&self, key: FixedKey, c: usize) -> Option<SlotRef<'_>> {
+        parameter_slot!(self, key, c)
     }
-}
 
-pub(super) fn read_boolean(p: &Parameters, key: FixedKey) -> Option<bool> {
-    match key {
-        FixedKey::NonlinearForces => Some(p.nonlinear_forces),
-        FixedKey::Auto => Some(p.auto),
-        _ => None,
+    /// The field of the fixed variable `key` (component `c`) to write, `None` for outputs.
+    pub(super) fn slot_mut(&mut self, key: FixedKey, c: usize) -> Option<SlotMut<'_>> {
+        parameter_slot!(self, key, c, mut)
+    }
+
+    /// The Real parameter `key` (component `c`), `None` for outputs and other types.
+    pub(super) fn real(&self, key: FixedKey, c: usize) -> Option<f64> {
+        match self.slot(key, c)? {
+            Slot::Real(x) => Some(*x),
+            _ => None,
+        }
+    }
+
+    /// The Integer parameter `key`.
+    pub(super) fn integer(&self, key: FixedKey) -> Option<i32> {
+        match self.slot(key, 0)? {
+            Slot::Integer(x) => Some(*x),
+            _ => None,
+        }
+    }
+
+    /// The Boolean parameter `key`.
+    pub(super) fn boolean(&self, key: FixedKey) -> Option<bool> {
+        match self.slot(key, 0)? {
+            Slot::Boolean(x) => Some(*x),
+            _ => None,
+        }
     }
 }

@@ -1,6 +1,7 @@
 //! VTK results of a run (`output.directory`).
 
 use super::{LogEvent, Slave};
+use crate::model::category;
 
 /// A file name made from a model name: characters other than letters, digits, `-`, `_` and `.`
 /// become `_`.
@@ -54,7 +55,7 @@ impl Slave {
     pub(super) fn output_failed(&mut self, reason: &str) {
         self.results = None;
         self.events.push(LogEvent {
-            category: "logStatusError",
+            category: category::ERROR,
             message: format!(
                 "error: output.directory = '{}': {reason}; no further results are written (the simulation goes on)",
                 self.parameters.output_directory

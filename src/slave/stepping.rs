@@ -5,6 +5,7 @@ use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
 use super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
+use crate::model::category;
 use crate::solver::generalized_alpha::{self, DynamicState, IterationSettings};
 use crate::solver::radau::{self, RadauProblem};
 use nalgebra::Vector3;
@@ -160,7 +161,7 @@ impl Slave {
         if g > DEFAULT_THRESHOLD && !*above {
             *above = true;
             self.events.push(LogEvent {
-                category: "logEvents",
+                category: category::EVENTS,
                 message: format!(
                     "warning: at t = {t} the deformation gradient in the co-moving frame reached ‖∇ū‖ ≈ {g:.3} (> {DEFAULT_THRESHOLD}): beyond the small-strain range of the reduced strain the results lose accuracy without other signs; use model.frames > 1 for large bending or model.formulation = full"
                 ),
@@ -168,7 +169,7 @@ impl Slave {
         } else if g < 0.5 * DEFAULT_THRESHOLD && *above {
             *above = false;
             self.events.push(LogEvent {
-                category: "logEvents",
+                category: category::EVENTS,
                 message: format!("at t = {t} ‖∇ū‖ ≈ {g:.3} is back within the small-strain range"),
             });
         }
@@ -240,7 +241,7 @@ impl Slave {
             depth += 1;
             self.retries += 1;
             self.events.push(LogEvent {
-                category: "logEvents",
+                category: category::EVENTS,
                 message: format!(
                     "internal step from t = {} (h = {hs:e}) did not converge ({}); retrying it as {} steps of {:e} s",
                     t_c + tau0,

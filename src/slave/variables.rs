@@ -1,12 +1,11 @@
 //! Variable access by value reference: typed get and set, start values, input derivatives.
 
-use super::parameters::{read_boolean, read_integer, read_parameter, write_parameter, Parameters};
+use super::parameters::{Parameters, Slot};
 use super::{Slave, MAX_INPUT_DERIVATIVE_ORDER};
 use crate::error::{Error, Result};
 use crate::model::model_description::format_real;
 use crate::model::variables::{EnumerationSpec, FixedKey, InterfaceQuantity};
 use crate::model::{InterfaceKind, Target, Variable, VariableType};
-use crate::solver::anderson::MAX_DEPTH;
 
 pub(super) fn component_of(v: &Variable) -> usize {
     match v.target {
@@ -66,14 +65,13 @@ impl Slave {
     pub fn get_string(&mut self, vr: u32) -> Result<String> {
         let v = self.lookup(VariableType::String, vr)?;
         match v.target {
-            Target::Fixed {
-                key: FixedKey::OutputDirectory,
-                ..
-            } => Ok(self.parameters.output_directory.clone()),
-            _ => Err(Error::new(format!(
-                "no String variable has value reference {vr}"
-            ))),
+            Target::Fixed { key, component } => match self.parameters.slot(key, component) {
+                Some(Slot::Text(text)) => Some(text.clone()),
+                _ => None,
+            },
+            Target::Interface { .. } => None,
         }
+        .ok_or_else(|| Error::new(format!("no String variable has value reference {vr}")))
     }
 
     /// Sets a String parameter (`output.directory`: any text; a directory that cannot be created
@@ -81,28 +79,28 @@ impl Slave {
     pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
         let v = self.lookup(VariableType::String, vr)?;
         match v.target {
-            Target::Fixed {
-                key: FixedKey::OutputDirectory,
-                ..
-            } => {
-                self.parameters.output_directory = value.to_string();
-                Ok(())
-            }
-            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+            Target::Fixed { key, component } => match self.parameters.slot_mut(key, component) {
+                Some(Slot::Text(text)) => {
+                    value.clone_into(text);
+                    Ok(())
+                }
+                _ => Err(Error::new(format!("{} cannot be set", v.name))),
+            },
+            Target::Interface { .. } => Err(Error::new(format!("{} cannot be set", v.name))),
         }
     }
 
     /// Start value of a parameter or input as written in the XML (full precision).
     pub(super) fn start_value(&self, v: &Variable) -> String {
         match (v.ty, v.target) {
-            (VariableType::Boolean, Target::Fixed { key, .. }) => read_boolean(&self.defaults, key)
-                .unwrap_or(false)
-                .to_string(),
+            (VariableType::Boolean, Target::Fixed { key, .. }) => {
+                self.defaults.boolean(key).unwrap_or(false).to_string()
+            }
             (VariableType::Integer, Target::Fixed { key, .. }) => {
-                read_integer(&self.defaults, key).unwrap_or(0).to_string()
+                self.defaults.integer(key).unwrap_or(0).to_string()
             }
             (VariableType::Real, Target::Fixed { key, component }) => {
-                format_real(read_parameter(&self.defaults, key, component).unwrap_or(0.0))
+                format_real(self.defaults.real(key, component).unwrap_or(0.0))
             }
             (VariableType::String, Target::Fixed { .. }) => self.defaults.output_directory.clone(),
             (
@@ -135,15 +133,13 @@ impl Slave {
             }
         };
         let value = match target {
-            Target::Fixed { key, component } => {
-                match read_parameter(&self.parameters, key, component) {
-                    Some(p) => p,
-                    None => {
-                        self.ensure_outputs()?;
-                        self.outputs.body[body_output_slot(key) + component]
-                    }
+            Target::Fixed { key, component } => match self.parameters.real(key, component) {
+                Some(p) => p,
+                None => {
+                    self.ensure_outputs()?;
+                    self.outputs.body[body_output_slot(key) + component]
                 }
-            }
+            },
             Target::Interface {
                 index,
                 quantity,
@@ -178,10 +174,15 @@ impl Slave {
         match v.target {
             Target::Fixed { key, component } => {
                 Parameters::check_real(&v.name, key, value)?;
-                let p = write_parameter(&mut self.parameters, key, component).ok_or_else(|| {
-                    Error::new(format!("{} is an output and cannot be set", v.name))
-                })?;
-                *p = value;
+                match self.parameters.slot_mut(key, component) {
+                    Some(Slot::Real(p)) => *p = value,
+                    _ => {
+                        return Err(Error::new(format!(
+                            "{} is an output and cannot be set",
+                            v.name
+                        )))
+                    }
+                }
             }
             Target::Interface {
                 index,
@@ -207,14 +208,32 @@ impl Slave {
     pub fn get_integer(&mut self, vr: u32) -> Result<i32> {
         let v = self.lookup(VariableType::Integer, vr)?;
         match v.target {
-            Target::Fixed { key, .. } => read_integer(&self.parameters, key),
+            Target::Fixed { key, .. } => self.parameters.integer(key),
             _ => None,
         }
         .ok_or_else(|| Error::new(format!("no Integer variable has value reference {vr}")))
     }
 
+    /// Sets an Integer parameter after [`Slave::check_integer`].
     pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
         let v = self.lookup(VariableType::Integer, vr)?;
+        self.check_integer(&v, value)?;
+        let slot = match v.target {
+            Target::Fixed { key, component } => self.parameters.slot_mut(key, component),
+            Target::Interface { .. } => None,
+        };
+        match slot {
+            Some(Slot::Integer(x)) => {
+                *x = value;
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        }
+    }
+
+    /// Checks an Integer value for `v`: an enumeration's items, the variable's `min` and `max`
+    /// (`modelDescription/variables.json`), and `model.frames` at most the number of elements.
+    fn check_integer(&self, v: &Variable, value: i32) -> Result<()> {
         if let Some(e) = v.declared_type.and_then(EnumerationSpec::by_name) {
             if value < 1 || value as usize > e.items.len() {
                 let names: Vec<String> = e
@@ -230,91 +249,37 @@ impl Slave {
                 ));
             }
         }
-        match v.target {
-            Target::Fixed {
-                key: FixedKey::MaxIterations,
-                ..
-            } => {
-                if value < 1 {
-                    return Err(Error::invalid_value(&v.name, value, "must be at least 1"));
-                }
-                self.parameters.max_iterations = value;
-                Ok(())
+        let x = f64::from(value);
+        let reason = match (v.min, v.max) {
+            (Some(lo), Some(hi)) if !(lo..=hi).contains(&x) => {
+                Some(format!("must lie in [{lo}, {hi}]"))
             }
-            Target::Fixed {
-                key: FixedKey::Integrator,
-                ..
-            } => {
-                self.parameters.integrator = value;
-                Ok(())
-            }
-            Target::Fixed {
-                key: FixedKey::AndersonDepth,
-                ..
-            } => {
-                if !(0..=MAX_DEPTH as i32).contains(&value) {
-                    return Err(Error::invalid_value(
-                        &v.name,
-                        value,
-                        &format!("must lie in [0, {MAX_DEPTH}]"),
-                    ));
-                }
-                self.parameters.anderson_depth = value;
-                Ok(())
-            }
-            Target::Fixed {
-                key: FixedKey::Formulation,
-                ..
-            } => {
-                self.parameters.formulation = value;
-                Ok(())
-            }
-            Target::Fixed {
-                key: FixedKey::Stiffening,
-                ..
-            } => {
-                self.parameters.stiffening = value;
-                Ok(())
-            }
+            (Some(lo), None) if x < lo && lo == 0.0 => Some("must not be negative".to_string()),
+            (Some(lo), None) if x < lo => Some(format!("must be at least {lo}")),
+            _ => None,
+        };
+        let elements = self.mesh.element_count();
+        let frames = matches!(
+            v.target,
             Target::Fixed {
                 key: FixedKey::Frames,
                 ..
-            } => {
-                if value < 1 || value as usize > self.mesh.element_count() {
-                    return Err(Error::invalid_value(
-                        &v.name,
-                        value,
-                        &format!(
-                            "must lie in [1, {}] (the number of elements)",
-                            self.mesh.element_count()
-                        ),
-                    ));
-                }
-                self.parameters.frames = value;
-                Ok(())
             }
-            Target::Fixed {
-                key: FixedKey::Modes,
-                ..
-            } => {
-                if value < 0 {
-                    return Err(Error::invalid_value(
-                        &v.name,
-                        value,
-                        "must not be negative (0: the full mesh)",
-                    ));
-                }
-                self.parameters.modes = value;
-                Ok(())
-            }
-            _ => Err(Error::new(format!("{} cannot be set", v.name))),
+        );
+        let reason = reason.or_else(|| {
+            (frames && value as usize > elements)
+                .then(|| format!("must lie in [1, {elements}] (the number of elements)"))
+        });
+        match reason {
+            Some(r) => Err(Error::invalid_value(&v.name, value, &r)),
+            None => Ok(()),
         }
     }
 
     pub fn get_boolean(&mut self, vr: u32) -> Result<bool> {
         let v = self.lookup(VariableType::Boolean, vr)?;
         match v.target {
-            Target::Fixed { key, .. } => read_boolean(&self.parameters, key),
+            Target::Fixed { key, .. } => self.parameters.boolean(key),
             _ => None,
         }
         .ok_or_else(|| Error::new(format!("no Boolean variable has value reference {vr}")))
@@ -322,19 +287,13 @@ impl Slave {
 
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
         let v = self.lookup(VariableType::Boolean, vr)?;
-        match v.target {
-            Target::Fixed {
-                key: FixedKey::NonlinearForces,
-                ..
-            } => {
-                self.parameters.nonlinear_forces = value;
-                Ok(())
-            }
-            Target::Fixed {
-                key: FixedKey::Auto,
-                ..
-            } => {
-                self.parameters.auto = value;
+        let slot = match v.target {
+            Target::Fixed { key, component } => self.parameters.slot_mut(key, component),
+            Target::Interface { .. } => None,
+        };
+        match slot {
+            Some(Slot::Boolean(x)) => {
+                *x = value;
                 Ok(())
             }
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
