@@ -1,13 +1,15 @@
 //! Interfaces at run time: their node sets and point constraints, the driving frames of motion
 //! interfaces, the loads of force interfaces, and the inputs as samples in time.
 
-use super::{InputDerivatives, Inputs, Slave};
+use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
 use crate::body::frame::{nearest_rotation, node};
 use crate::body::interface::DrivingFrame;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
+use crate::fem;
+use crate::mesh::Mesh;
 use crate::model::variables::InterfaceQuantity;
-use crate::model::InterfaceKind;
+use crate::model::{BodyFile, InterfaceKind};
 use crate::solver::generalized_alpha::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
@@ -279,4 +281,68 @@ impl Slave {
             InterfaceKind::Fixed | InterfaceKind::Pin | InterfaceKind::Hinge => {}
         }
     }
+}
+
+/// The interfaces of `body_file` on `mesh` (node sets weighted by the lumped masses of a unit
+/// density, point constraints of pins and hinges), and which nodes fixed supports and motion
+/// interfaces hold. `size` is the body's characteristic size (m).
+pub(super) fn interfaces_of(
+    body_file: &BodyFile,
+    mesh: &Mesh,
+    size: f64,
+) -> Result<(Vec<Interface>, Vec<bool>)> {
+    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+    let lumped = fem::lumped_masses(mesh, 1.0);
+    let mut interfaces = Vec::new();
+    let mut clamped = vec![false; mesh.node_count()];
+    for spec in &body_file.interfaces {
+        let nodes = spec
+            .nodes
+            .select(mesh)
+            .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
+        let weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
+        if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
+            for &i in &nodes {
+                clamped[i] = true;
+            }
+        }
+        let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
+        let set = NodeSet::new(
+            &spec.name,
+            nodes,
+            weights,
+            &reference,
+            spec.reference_point.map(Vector3::from),
+        )?;
+        interfaces.push(Interface {
+            kind: spec.kind,
+            set,
+            point_constraints,
+            first_constraint: 0,
+        });
+    }
+    if clamped.iter().all(|&c| c) {
+        return Err(Error::new(
+            "body file: fixed supports hold every node: nothing can move",
+        ));
+    }
+    Ok((interfaces, clamped))
+}
+
+/// The inputs of a fresh instance: motion interfaces at their place in the body file, at rest;
+/// no loads.
+pub(super) fn default_inputs(interfaces: &[Interface]) -> Vec<Inputs> {
+    interfaces
+        .iter()
+        .map(|i| {
+            let mut values = [0.0; INTERFACE_SLOTS];
+            if i.kind == InterfaceKind::Motion {
+                let p = InterfaceQuantity::Position.slot() as usize;
+                values[p..p + 3].copy_from_slice(i.set.reference_point.as_slice());
+                let r = InterfaceQuantity::Rotation.slot() as usize;
+                values[r..r + 9].copy_from_slice(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+            }
+            values
+        })
+        .collect()
 }

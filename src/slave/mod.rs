@@ -3,18 +3,17 @@
 //! arguments and the calling sequence.
 
 use crate::body::interface::DrivingFrame;
-use crate::body::{Body, NodeSet};
+use crate::body::Body;
 use crate::error::{Error, Result};
-use crate::fem::{self};
 use crate::mesh::Mesh;
 use crate::model::category;
 use crate::model::model_description::{model_description, ModelInfo};
-use crate::model::variables::{InterfaceQuantity, FIXED_TABLE_FINGERPRINT};
-use crate::model::{BodyFile, InterfaceKind, Target, Variable, VariableTable, VariableType};
+use crate::model::variables::FIXED_TABLE_FINGERPRINT;
+use crate::model::{BodyFile, Target, Variable, VariableTable, VariableType};
 use crate::output::ResultWriter;
 use crate::solver::generalized_alpha::{DynamicState, FreeNodes, IterationMatrix};
 use assembly::Model;
-use interfaces::{point_constraints, Interface};
+use interfaces::{default_inputs, interfaces_of, Interface};
 use nalgebra::Vector3;
 use outputs::Outputs;
 use results::file_stem;
@@ -38,7 +37,11 @@ pub use stepping::MAX_STEP_HALVINGS;
 
 /// The input values of one interface, indexed by value-reference slot
 /// ([`InterfaceQuantity::slot`]).
-type Inputs = [f64; 30];
+type Inputs = [f64; INTERFACE_SLOTS];
+
+/// Value-reference slots of one interface (`1000 + 100 k + slot`): force, torque and the six
+/// motion quantities, 30 numbers (see [`InterfaceQuantity::slot`]).
+const INTERFACE_SLOTS: usize = 30;
 
 /// The first and second time derivatives of one interface's inputs (`fmi2SetRealInputDerivatives`;
 /// only the force and torque slots of force interfaces are ever non-zero).
@@ -173,43 +176,9 @@ impl Slave {
     pub fn from_body_in(body_file: BodyFile, base_dir: Option<&Path>) -> Result<Slave> {
         body_file.check()?;
         let mesh = body_file.mesh.build(base_dir)?;
-        let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
-        let lumped = fem::lumped_masses(&mesh, 1.0);
-        let mut interfaces = Vec::new();
-        let mut clamped = vec![false; mesh.node_count()];
         let (lo, hi) = mesh.bounding_box();
         let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
-        for spec in &body_file.interfaces {
-            let nodes = spec
-                .nodes
-                .select(&mesh)
-                .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
-            let weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
-            if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
-                for &i in &nodes {
-                    clamped[i] = true;
-                }
-            }
-            let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
-            let set = NodeSet::new(
-                &spec.name,
-                nodes,
-                weights,
-                &reference,
-                spec.reference_point.map(Vector3::from),
-            )?;
-            interfaces.push(Interface {
-                kind: spec.kind,
-                set,
-                point_constraints,
-                first_constraint: 0,
-            });
-        }
-        if clamped.iter().all(|&c| c) {
-            return Err(Error::new(
-                "body file: fixed supports hold every node: nothing can move",
-            ));
-        }
+        let (interfaces, clamped) = interfaces_of(&body_file, &mesh, size)?;
         let variables = VariableTable::new(&body_file.interfaces);
         let defaults = Parameters::from_body_file(&body_file);
         for v in variables.iter() {
@@ -224,21 +193,7 @@ impl Slave {
         let element_regions = body_file.element_regions(&mesh)?;
         let guid = guid_of(&body_file);
         let n_interfaces = interfaces.len();
-        // Motion interfaces start at their place in the body file, at rest.
-        let default_inputs: Vec<Inputs> = interfaces
-            .iter()
-            .map(|i| {
-                let mut values = [0.0; 30];
-                if i.kind == InterfaceKind::Motion {
-                    let p = InterfaceQuantity::Position.slot() as usize;
-                    values[p..p + 3].copy_from_slice(i.set.reference_point.as_slice());
-                    let r = InterfaceQuantity::Rotation.slot() as usize;
-                    values[r..r + 9]
-                        .copy_from_slice(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
-                }
-                values
-            })
-            .collect();
+        let default_inputs = default_inputs(&interfaces);
         Ok(Slave {
             body_file,
             variables,
@@ -252,7 +207,7 @@ impl Slave {
             defaults,
             inputs: default_inputs.clone(),
             default_inputs,
-            input_derivatives: vec![[[0.0; 30]; 2]; n_interfaces],
+            input_derivatives: vec![[[0.0; INTERFACE_SLOTS]; 2]; n_interfaces],
             input_times: vec![0.0; n_interfaces],
             input_ages: vec![0.0; n_interfaces],
             driving: vec![DrivingFrame::default(); n_interfaces],
@@ -262,7 +217,7 @@ impl Slave {
             backup: None,
             retry_backup: None,
             outputs: Outputs {
-                interfaces: vec![[0.0; 30]; n_interfaces],
+                interfaces: vec![[0.0; INTERFACE_SLOTS]; n_interfaces],
                 ..Outputs::default()
             },
             statistics: (0, 0),
@@ -430,7 +385,7 @@ impl Slave {
         self.parameters = self.defaults.clone();
         self.inputs.clone_from(&self.default_inputs);
         for d in &mut self.input_derivatives {
-            *d = [[0.0; 30]; 2];
+            *d = [[0.0; INTERFACE_SLOTS]; 2];
         }
         self.start_time = 0.0;
         self.input_times.fill(0.0);

@@ -1,6 +1,7 @@
 //! Outputs, computed once per state on the first read, and their time derivatives.
 
 use super::interfaces::{apply_loads, Interface};
+use super::variables::body_output_slot;
 use super::{Inputs, Slave, MAX_OUTPUT_DERIVATIVE_ORDER};
 use crate::body::frame::node;
 use crate::body::interface::InterfaceMotion;
@@ -20,7 +21,7 @@ pub(super) struct Outputs {
     pub(super) body_acceleration: [f64; 3],
     /// Per interface: force[3], torque[3], then motion (position, rotation, velocity, angular
     /// velocity, acceleration, angular acceleration) in value-reference slot order.
-    pub(super) interfaces: Vec<[f64; 30]>,
+    pub(super) interfaces: Vec<Inputs>,
     /// Scratch `M ẋ` (flat, the body's size; resized only when the model changes).
     pub(super) momentum: Vec<f64>,
 }
@@ -119,57 +120,22 @@ impl Slave {
             ));
         }
         self.ensure_outputs()?;
-        let rotation_rate = |r: &[f64], w: &[f64], a: Option<&[f64]>, c: usize| {
-            let r = Matrix3::from_row_slice(r);
-            let w = Vector3::from_column_slice(w).cross_matrix();
-            let rate = match a {
-                None => w * r,
-                Some(a) => (Vector3::from_column_slice(a).cross_matrix() + w * w) * r,
-            };
-            rate[(c / 3, c % 3)]
-        };
-        use InterfaceQuantity as Q;
-        let slot = |q: Q| q.slot() as usize;
         let value = match target {
             Target::Interface {
                 index,
                 quantity,
-                component: c,
+                component,
             } if self.interfaces[index].kind == InterfaceKind::Force => {
-                let out = &self.outputs.interfaces[index];
-                let three = |q: Q| &out[slot(q)..slot(q) + 3];
-                match (quantity, order) {
-                    (Q::Position, 1) => Some(out[slot(Q::Velocity) + c]),
-                    (Q::Position, 2) | (Q::Velocity, 1) => Some(out[slot(Q::Acceleration) + c]),
-                    (Q::AngularVelocity, 1) => Some(out[slot(Q::AngularAcceleration) + c]),
-                    (Q::Rotation, 1) => Some(rotation_rate(
-                        &out[slot(Q::Rotation)..slot(Q::Rotation) + 9],
-                        three(Q::AngularVelocity),
-                        None,
-                        c,
-                    )),
-                    (Q::Rotation, 2) => Some(rotation_rate(
-                        &out[slot(Q::Rotation)..slot(Q::Rotation) + 9],
-                        three(Q::AngularVelocity),
-                        Some(three(Q::AngularAcceleration)),
-                        c,
-                    )),
-                    _ => None,
-                }
+                interface_output_derivative(
+                    &self.outputs.interfaces[index],
+                    quantity,
+                    component,
+                    order,
+                )
             }
-            Target::Fixed { key, component: c } => {
-                let body = &self.outputs.body;
-                let acom = &self.outputs.body_acceleration;
+            Target::Fixed { key, component } => {
                 let mass = self.model.as_ref().map_or(0.0, |m| m.body.total_mass);
-                match (key, order) {
-                    (FixedKey::BodyPosition, 1) => Some(body[12 + c]),
-                    (FixedKey::BodyPosition, 2) | (FixedKey::BodyVelocity, 1) => Some(acom[c]),
-                    (FixedKey::BodyLinearMomentum, 1) => Some(mass * acom[c]),
-                    (FixedKey::BodyRotation, 1) => {
-                        Some(rotation_rate(&body[3..12], &body[15..18], None, c))
-                    }
-                    _ => None,
-                }
+                body_output_derivative(&self.outputs, mass, key, component, order)
             }
             _ => None,
         };
@@ -213,20 +179,23 @@ fn body_outputs(body: &Body, state: &DynamicState, kin: &BodyKinematics, outputs
     }
     let r = kin.frame.rotation;
     let omega = r * kin.angular_velocity_body;
-    let out = &mut outputs.body;
-    out[0..3].copy_from_slice(com.as_slice());
-    for (k, value) in out[3..12].iter_mut().enumerate() {
-        *value = r[(k / 3, k % 3)];
-    }
-    out[12..15].copy_from_slice(vcom.as_slice());
-    out[15..18].copy_from_slice(omega.as_slice());
-    out[18..21].copy_from_slice((m * vcom).as_slice());
-    out[21..24].copy_from_slice(angular.as_slice());
-    out[24] = kinetic;
-    out[25] = match &body.full {
+    let strain_energy = match &body.full {
         Some(full) => full.strain_energy(&state.position),
         None => kin.strain_energy,
     };
+    let out = &mut outputs.body;
+    let mut put = |key: FixedKey, values: &[f64]| {
+        let at = body_output_slot(key);
+        out[at..at + values.len()].copy_from_slice(values);
+    };
+    put(FixedKey::BodyPosition, com.as_slice());
+    put(FixedKey::BodyRotation, r.transpose().as_slice()); // row-major
+    put(FixedKey::BodyVelocity, vcom.as_slice());
+    put(FixedKey::BodyAngularVelocity, omega.as_slice());
+    put(FixedKey::BodyLinearMomentum, (m * vcom).as_slice());
+    put(FixedKey::BodyAngularMomentum, angular.as_slice());
+    put(FixedKey::BodyKineticEnergy, &[kinetic]);
+    put(FixedKey::BodyStrainEnergy, &[strain_energy]);
 }
 
 /// The outputs of one interface (value-reference slot order) in `state`, with `residual` the
@@ -240,6 +209,11 @@ fn interface_outputs(
     load: &Inputs,
     out: &mut Inputs,
 ) {
+    use InterfaceQuantity as Q;
+    let put = |out: &mut Inputs, q: Q, values: &[f64]| {
+        let at = q.slot() as usize;
+        out[at..at + values.len()].copy_from_slice(values);
+    };
     match interface.kind {
         InterfaceKind::Pin | InterfaceKind::Hinge => {
             // The constraint load on the body is −Cᵀλ: per point constraint a force −λ_k
@@ -260,29 +234,98 @@ fn interface_outputs(
                 force += f;
                 torque += (constraint.centroid(&state.position) - p).cross(&f);
             }
-            out[0..3].copy_from_slice(force.as_slice());
-            out[3..6].copy_from_slice(torque.as_slice());
+            put(out, Q::Force, force.as_slice());
+            put(out, Q::Torque, torque.as_slice());
         }
         InterfaceKind::Fixed | InterfaceKind::Motion => {
             // Reaction of the support on the body: λ_C = (M ẍ + f − f_ext)_C.
             let (f, t) = interface.set.resultant(&state.position, residual);
-            out[0..3].copy_from_slice(f.as_slice());
-            out[3..6].copy_from_slice(t.as_slice());
+            put(out, Q::Force, f.as_slice());
+            put(out, Q::Torque, t.as_slice());
         }
         InterfaceKind::Force => {
-            out[0..6].copy_from_slice(&load[0..6]);
+            let (f, t) = (Q::Force.slot() as usize, Q::Torque.slot() as usize);
+            out[f..f + 3].copy_from_slice(&load[f..f + 3]);
+            out[t..t + 3].copy_from_slice(&load[t..t + 3]);
             let m: InterfaceMotion =
                 interface
                     .set
                     .motion(&state.position, &state.velocity, &state.acceleration);
-            out[6..9].copy_from_slice(m.position.as_slice());
-            for (j, value) in out[9..18].iter_mut().enumerate() {
-                *value = m.rotation[(j / 3, j % 3)];
-            }
-            out[18..21].copy_from_slice(m.velocity.as_slice());
-            out[21..24].copy_from_slice(m.angular_velocity.as_slice());
-            out[24..27].copy_from_slice(m.acceleration.as_slice());
-            out[27..30].copy_from_slice(m.angular_acceleration.as_slice());
+            put(out, Q::Position, m.position.as_slice());
+            put(out, Q::Rotation, m.rotation.transpose().as_slice()); // row-major
+            put(out, Q::Velocity, m.velocity.as_slice());
+            put(out, Q::AngularVelocity, m.angular_velocity.as_slice());
+            put(out, Q::Acceleration, m.acceleration.as_slice());
+            put(
+                out,
+                Q::AngularAcceleration,
+                m.angular_acceleration.as_slice(),
+            );
         }
+    }
+}
+
+/// Component `c` (row-major) of `Ṙ = [ω]× R`, or with the angular acceleration `α` of
+/// `R̈ = ([α]× + [ω]×[ω]×) R`.
+fn rotation_rate(r: &[f64], w: &[f64], a: Option<&[f64]>, c: usize) -> f64 {
+    let r = Matrix3::from_row_slice(r);
+    let w = Vector3::from_column_slice(w).cross_matrix();
+    let rate = match a {
+        None => w * r,
+        Some(a) => (Vector3::from_column_slice(a).cross_matrix() + w * w) * r,
+    };
+    rate[(c / 3, c % 3)]
+}
+
+/// Derivative `order` of component `c` of a force interface's output `quantity`, from its
+/// outputs `out` (the rates of the least-squares rigid motion of its node set).
+fn interface_output_derivative(
+    out: &Inputs,
+    quantity: InterfaceQuantity,
+    c: usize,
+    order: i32,
+) -> Option<f64> {
+    use InterfaceQuantity as Q;
+    let slot = |q: Q| q.slot() as usize;
+    let three = |q: Q| &out[slot(q)..slot(q) + 3];
+    let rotation = &out[slot(Q::Rotation)..slot(Q::Rotation) + 9];
+    match (quantity, order) {
+        (Q::Position, 1) => Some(out[slot(Q::Velocity) + c]),
+        (Q::Position, 2) | (Q::Velocity, 1) => Some(out[slot(Q::Acceleration) + c]),
+        (Q::AngularVelocity, 1) => Some(out[slot(Q::AngularAcceleration) + c]),
+        (Q::Rotation, 1) => Some(rotation_rate(rotation, three(Q::AngularVelocity), None, c)),
+        (Q::Rotation, 2) => Some(rotation_rate(
+            rotation,
+            three(Q::AngularVelocity),
+            Some(three(Q::AngularAcceleration)),
+            c,
+        )),
+        _ => None,
+    }
+}
+
+/// Derivative `order` of component `c` of the body output `key` (total mass `mass`).
+fn body_output_derivative(
+    outputs: &Outputs,
+    mass: f64,
+    key: FixedKey,
+    c: usize,
+    order: i32,
+) -> Option<f64> {
+    let body = &outputs.body;
+    let acom = &outputs.body_acceleration;
+    let at = |k: FixedKey| body_output_slot(k);
+    match (key, order) {
+        (FixedKey::BodyPosition, 1) => Some(body[at(FixedKey::BodyVelocity) + c]),
+        (FixedKey::BodyPosition, 2) | (FixedKey::BodyVelocity, 1) => Some(acom[c]),
+        (FixedKey::BodyLinearMomentum, 1) => Some(mass * acom[c]),
+        (FixedKey::BodyRotation, 1) => {
+            let (r, w) = (
+                at(FixedKey::BodyRotation),
+                at(FixedKey::BodyAngularVelocity),
+            );
+            Some(rotation_rate(&body[r..r + 9], &body[w..w + 3], None, c))
+        }
+        _ => None,
     }
 }

@@ -20,7 +20,7 @@
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
 //! with a message, never a panic or a NaN later.
 
-use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState};
+use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, INTERFACE_SLOTS};
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::variables::FixedKey;
@@ -233,11 +233,11 @@ impl Slave {
             }
         };
         check_parameters(&p)?;
-        let mut inputs: Vec<Inputs> = vec![[0.0; 30]; n];
+        let mut inputs: Vec<Inputs> = vec![[0.0; INTERFACE_SLOTS]; n];
         for i in &mut inputs {
             r.f64s(i, "an input")?;
         }
-        let mut input_derivatives: Vec<InputDerivatives> = vec![[[0.0; 30]; 2]; n];
+        let mut input_derivatives: Vec<InputDerivatives> = vec![[[0.0; INTERFACE_SLOTS]; 2]; n];
         for d in &mut input_derivatives {
             r.f64s(&mut d[0], "an input derivative")?;
             r.f64s(&mut d[1], "an input derivative")?;
@@ -287,7 +287,7 @@ impl Slave {
                 r.count(multipliers, "constraint multipliers")?;
                 let mut lambda = vec![0.0; multipliers];
                 r.f64s(&mut lambda, "the constraint multipliers")?;
-                let mut loads: Vec<Inputs> = vec![[0.0; 30]; n];
+                let mut loads: Vec<Inputs> = vec![[0.0; INTERFACE_SLOTS]; n];
                 for l in &mut loads {
                     r.f64s(l, "the loads of the state")?;
                 }
