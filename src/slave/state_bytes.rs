@@ -189,6 +189,45 @@ impl Slave {
                 self.inputs.len()
             )));
         }
+        let p = self.read_parameters(&mut r)?;
+        let mut inputs: Vec<Inputs> = vec![[0.0; INTERFACE_SLOTS]; n];
+        for i in &mut inputs {
+            r.f64s(i, "an input")?;
+        }
+        let mut input_derivatives: Vec<InputDerivatives> = vec![[[0.0; INTERFACE_SLOTS]; 2]; n];
+        for d in &mut input_derivatives {
+            r.f64s(&mut d[0], "an input derivative")?;
+            r.f64s(&mut d[1], "an input derivative")?;
+        }
+        let mut input_times = vec![0.0; n];
+        r.f64s(&mut input_times, "an input sample time")?;
+        let start_time = r.f64("the start time")?;
+        let counters = [
+            r.u64("the step counter")?,
+            r.u64("the iteration counter")?,
+            r.u64("the retry counter")?,
+        ];
+        let dynamics = self.read_dynamics(&mut r, &p, n)?;
+        if r.at != bytes.len() {
+            return Err(Error::new(format!(
+                "the serialized FMU state has {} bytes after its end (byte {})",
+                bytes.len() - r.at,
+                r.at
+            )));
+        }
+        Ok(SlaveState {
+            parameters: p,
+            inputs,
+            input_derivatives,
+            input_times,
+            start_time,
+            dynamics,
+            counters,
+        })
+    }
+
+    /// The parameters of a payload, checked as `fmi2SetReal`/`fmi2SetInteger` would.
+    fn read_parameters(&self, r: &mut Reader) -> Result<Parameters> {
         let mut p = self.defaults.clone();
         let mut head = [0.0; 5];
         r.f64s(&mut head, "material and damping parameters")?;
@@ -233,24 +272,13 @@ impl Slave {
             }
         };
         check_parameters(&p)?;
-        let mut inputs: Vec<Inputs> = vec![[0.0; INTERFACE_SLOTS]; n];
-        for i in &mut inputs {
-            r.f64s(i, "an input")?;
-        }
-        let mut input_derivatives: Vec<InputDerivatives> = vec![[[0.0; INTERFACE_SLOTS]; 2]; n];
-        for d in &mut input_derivatives {
-            r.f64s(&mut d[0], "an input derivative")?;
-            r.f64s(&mut d[1], "an input derivative")?;
-        }
-        let mut input_times = vec![0.0; n];
-        r.f64s(&mut input_times, "an input sample time")?;
-        let start_time = r.f64("the start time")?;
-        let counters = [
-            r.u64("the step counter")?,
-            r.u64("the iteration counter")?,
-            r.u64("the retry counter")?,
-        ];
-        let dynamics = match r.u8("the initialization flag")? {
+        Ok(p)
+    }
+
+    /// The dynamics of a payload for parameters `p` and `n` interfaces (`None` before
+    /// initialization); every count is checked against this body.
+    fn read_dynamics(&self, r: &mut Reader, p: &Parameters, n: usize) -> Result<Option<Dynamics>> {
+        Ok(match r.u8("the initialization flag")? {
             0 => None,
             1 => {
                 let time = r.f64("the time")?;
@@ -330,22 +358,6 @@ impl Slave {
                     "the serialized FMU state holds {b} for the initialization flag: not 0 or 1"
                 )))
             }
-        };
-        if r.at != bytes.len() {
-            return Err(Error::new(format!(
-                "the serialized FMU state has {} bytes after its end (byte {})",
-                bytes.len() - r.at,
-                r.at
-            )));
-        }
-        Ok(SlaveState {
-            parameters: p,
-            inputs,
-            input_derivatives,
-            input_times,
-            start_time,
-            dynamics,
-            counters,
         })
     }
 }
