@@ -22,6 +22,7 @@ use variables::component_of;
 
 mod assembly;
 mod auto_features;
+mod cosim;
 mod initial_state;
 mod interfaces;
 mod outputs;
@@ -31,6 +32,7 @@ mod state_bytes;
 mod stepping;
 mod variables;
 pub use assembly::{Features, MATRIX_CACHE_SIZE};
+pub use cosim::CoSimSlave;
 pub use parameters::Parameters;
 pub use state_bytes::PAYLOAD_FORMAT as STATE_PAYLOAD_FORMAT;
 pub use stepping::MAX_STEP_HALVINGS;
