@@ -28,14 +28,11 @@
 use super::logger::{category, Logger};
 use super::types::fmi2Status;
 use crate::error::ErrorKind;
-use crate::model::{Causality, Variable, VariableType};
 pub use crate::slave::CoSimSlave;
 
 mod snapshot;
 mod values;
-use snapshot::SNAPSHOT_MAGIC;
 pub use snapshot::{Snapshot, SERIALIZED_FORMAT, SERIALIZED_MAGIC};
-use values::type_name;
 pub use values::{settability_violation, FromSlave, ToSlave};
 
 /// The states of the FMI 2.0 co-simulation calling sequence (StepInProgress never occurs: every
@@ -320,167 +317,6 @@ impl<S: CoSimSlave> Instance<S> {
         fmi2Status::fmi2OK
     }
 
-    /// Looks up `vr` of type `ty`; the error names the value reference and, when it exists with
-    /// another type, that type.
-    fn lookup(&self, ty: VariableType, vr: u32) -> std::result::Result<&Variable, String> {
-        let table = self.slave.variables();
-        table.get(ty, vr).ok_or_else(|| {
-            let other = [
-                VariableType::Real,
-                VariableType::Integer,
-                VariableType::Boolean,
-                VariableType::String,
-            ]
-            .into_iter()
-            .find_map(|t| table.get(t, vr));
-            match other {
-                Some(v) => format!(
-                    "value reference {vr} is the {} variable {}, not a {} variable",
-                    type_name(v.ty),
-                    v.name,
-                    type_name(ty)
-                ),
-                None => format!("unknown {} value reference {vr}", type_name(ty)),
-            }
-        })
-    }
-
-    /// `fmi2Get{Real,Integer,Boolean}`: `values[i]` of `vrs[i]` (same length, checked by the
-    /// caller). Non-finite Reals are refused rather than passed on.
-    pub fn get_values<T: FromSlave<S> + Copy + std::fmt::Debug>(
-        &mut self,
-        function: &str,
-        vrs: &[u32],
-        values: &mut [T],
-    ) -> fmi2Status {
-        debug_assert_eq!(vrs.len(), values.len());
-        if let Err(s) = self.check_state(function, GET) {
-            return s;
-        }
-        for (&vr, out) in vrs.iter().zip(values.iter_mut()) {
-            let name = match self.lookup(T::TYPE, vr) {
-                Ok(v) => v.name.clone(),
-                Err(e) => return self.fail(function, &e),
-            };
-            match T::get(&mut self.slave, vr) {
-                Ok(x) if x.is_non_finite() => {
-                    return self.fail(function, &format!("{name} (value reference {vr}) is {x:?}"));
-                }
-                Ok(x) => *out = x,
-                Err(e) => return self.report(function, &e),
-            }
-        }
-        fmi2Status::fmi2OK
-    }
-
-    /// `fmi2Set{Real,Integer,Boolean}`: checks every value reference, its settability in the
-    /// current state and (Reals) its value before setting any value; then sets them in order
-    /// (the slave rejects bad values with a message naming the variable).
-    pub fn set_values<T: ToSlave<S>>(
-        &mut self,
-        function: &str,
-        vrs: &[u32],
-        values: &[T],
-    ) -> fmi2Status {
-        debug_assert_eq!(vrs.len(), values.len());
-        if let Err(s) = self.check_state(function, SET) {
-            return s;
-        }
-        for &vr in vrs {
-            let reason = match self.lookup(T::TYPE, vr) {
-                Ok(v) => settability_violation(self.state, v)
-                    .map(|r| format!("{r} (value reference {vr}, state {:?})", self.state)),
-                Err(e) => Some(e),
-            };
-            if let Some(reason) = reason {
-                return self.fail(function, &reason);
-            }
-        }
-        for (&vr, &x) in vrs.iter().zip(values) {
-            if let Err(e) = T::check(&self.slave, vr, x) {
-                return self.report(function, &e);
-            }
-        }
-        for (&vr, &x) in vrs.iter().zip(values) {
-            if let Err(e) = T::set(&mut self.slave, vr, x) {
-                return self.report(function, &e);
-            }
-        }
-        fmi2Status::fmi2OK
-    }
-
-    /// `fmi2GetString`: the values of `vrs`, kept in the instance until its next
-    /// `fmi2GetString` (the caller hands out pointers into them). A value with a NUL byte is
-    /// refused.
-    pub fn get_strings(
-        &mut self,
-        function: &str,
-        vrs: &[u32],
-    ) -> (fmi2Status, &[std::ffi::CString]) {
-        if let Err(s) = self.check_state(function, GET) {
-            return (s, &[]);
-        }
-        let mut values = Vec::with_capacity(vrs.len());
-        for &vr in vrs {
-            if let Err(e) = self.lookup(VariableType::String, vr) {
-                return (self.fail(function, &e), &[]);
-            }
-            match self.slave.get_string(vr) {
-                Ok(text) => match std::ffi::CString::new(text) {
-                    Ok(c) => values.push(c),
-                    Err(_) => {
-                        let status = self.fail(
-                            function,
-                            &format!("String value reference {vr} holds a NUL character"),
-                        );
-                        return (status, &[]);
-                    }
-                },
-                Err(e) => return (self.report(function, &e), &[]),
-            }
-        }
-        self.strings = values;
-        (fmi2Status::fmi2OK, &self.strings)
-    }
-
-    /// `fmi2SetString`: like [`Self::set_values`]; a NULL string (None) is an error naming the
-    /// variable.
-    pub fn set_strings(
-        &mut self,
-        function: &str,
-        vrs: &[u32],
-        values: &[Option<String>],
-    ) -> fmi2Status {
-        debug_assert_eq!(vrs.len(), values.len());
-        if let Err(s) = self.check_state(function, SET) {
-            return s;
-        }
-        for (&vr, value) in vrs.iter().zip(values) {
-            let reason = match self.lookup(VariableType::String, vr) {
-                Ok(v) => settability_violation(self.state, v)
-                    .map(|r| format!("{r} (value reference {vr}, state {:?})", self.state))
-                    .or_else(|| {
-                        value
-                            .is_none()
-                            .then(|| format!("{} = NULL rejected: not a string", v.name))
-                    }),
-                Err(e) => Some(e),
-            };
-            if let Some(reason) = reason {
-                return self.fail(function, &reason);
-            }
-        }
-        for (&vr, value) in vrs.iter().zip(values) {
-            if let Err(e) = self
-                .slave
-                .set_string(vr, value.as_deref().unwrap_or_default())
-            {
-                return self.report(function, &e);
-            }
-        }
-        fmi2Status::fmi2OK
-    }
-
     /// `fmi2DoStep`: `h` must be finite and > 0; the slave checks `t` against its time. A
     /// discarded step (no convergence, rolled back) gives StepFailed; an error gives Error.
     pub fn do_step(&mut self, t: f64, h: f64) -> fmi2Status {
@@ -515,68 +351,6 @@ impl<S: CoSimSlave> Instance<S> {
                 status
             }
         }
-    }
-
-    /// `fmi2SetRealInputDerivatives` (`canInterpolateInputs="true"`): allowed where inputs may be
-    /// set; every value reference must be a Real input and every order 1 or 2 (what the slave
-    /// can use); all or nothing.
-    pub fn set_real_input_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        values: &[f64],
-    ) -> fmi2Status {
-        const F: &str = "fmi2SetRealInputDerivatives";
-        if let Err(s) = self.check_state(F, SET) {
-            return s;
-        }
-        for (&vr, &order) in vrs.iter().zip(orders) {
-            let reason = match self.lookup(VariableType::Real, vr) {
-                Ok(v) if v.causality != Causality::Input => {
-                    Some(format!("{} (value reference {vr}) is not an input", v.name))
-                }
-                Ok(v) if order < 1 => Some(format!(
-                    "order = {order} rejected for {} (value reference {vr}): must be at least 1",
-                    v.name
-                )),
-                Ok(_) => None,
-                Err(e) => Some(e),
-            };
-            if let Some(reason) = reason {
-                return self.fail(F, &reason);
-            }
-        }
-        match self.slave.set_real_input_derivatives(vrs, orders, values) {
-            Ok(()) => fmi2Status::fmi2OK,
-            Err(e) => self.report(F, &e),
-        }
-    }
-
-    /// `fmi2GetRealOutputDerivatives` (`maxOutputDerivativeOrder="2"`): every value reference
-    /// must be a Real output; the slave says which derivatives exist.
-    pub fn get_real_output_derivatives(
-        &mut self,
-        vrs: &[u32],
-        orders: &[i32],
-        values: &mut [f64],
-    ) -> fmi2Status {
-        const F: &str = "fmi2GetRealOutputDerivatives";
-        if let Err(s) = self.check_state(F, OUTPUT_DERIVATIVES) {
-            return s;
-        }
-        for ((&vr, &order), out) in vrs.iter().zip(orders).zip(values.iter_mut()) {
-            if let Err(e) = self.lookup(VariableType::Real, vr) {
-                return self.fail(F, &e);
-            }
-            match self.slave.get_real_output_derivative(vr, order) {
-                Ok(x) if x.is_finite() => *out = x,
-                Ok(x) => {
-                    return self.fail(F, &format!("the derivative of value reference {vr} is {x}"))
-                }
-                Err(e) => return self.report(F, &e),
-            }
-        }
-        fmi2Status::fmi2OK
     }
 
     /// Functions this FMU does not support (`fmi2GetDirectionalDerivative`): `fmi2Error` with a
@@ -671,64 +445,6 @@ impl<S: CoSimSlave> Instance<S> {
             return s;
         }
         self.status_kind_error(F, kind)
-    }
-
-    /// `fmi2GetFMUstate` (new snapshot) — the caller boxes it or overwrites an old one.
-    pub fn snapshot(
-        &mut self,
-        function: &str,
-    ) -> std::result::Result<Snapshot<S::State>, fmi2Status> {
-        self.check_state(function, ANY_BUT_FATAL)?;
-        Ok(Snapshot {
-            magic: SNAPSHOT_MAGIC,
-            guid: self.slave.guid().to_string(),
-            slave: self.slave.get_state(),
-            machine: self.state,
-            terminate_requested: self.terminate_requested,
-        })
-    }
-
-    /// `fmi2SetFMUstate`: restores the slave and the calling-sequence state; the snapshot stays
-    /// valid.
-    pub fn restore(&mut self, snapshot: &Snapshot<S::State>) -> fmi2Status {
-        const F: &str = "fmi2SetFMUstate";
-        if let Err(s) = self.check_state(F, ANY_BUT_FATAL) {
-            return s;
-        }
-        if !snapshot.is_valid() {
-            return self.fail(
-                F,
-                "the FMU state is not a live state of this FMU (freed, or from another FMU)",
-            );
-        }
-        if snapshot.guid != self.slave.guid() {
-            return self.fail(
-                F,
-                &format!(
-                    "the FMU state belongs to an FMU with GUID {}, this instance has {}",
-                    snapshot.guid,
-                    self.slave.guid()
-                ),
-            );
-        }
-        match self.slave.set_state(&snapshot.slave) {
-            Ok(()) => {
-                self.state = snapshot.machine;
-                self.terminate_requested = snapshot.terminate_requested;
-                self.logger.event(&format!(
-                    "{F}: restored state {:?} at t = {}",
-                    self.state,
-                    self.slave.time()
-                ));
-                fmi2Status::fmi2OK
-            }
-            Err(e) => self.report(F, &e),
-        }
-    }
-
-    /// Checks the state for `fmi2FreeFMUstate`.
-    pub fn may_free_state(&mut self) -> std::result::Result<(), fmi2Status> {
-        self.check_state("fmi2FreeFMUstate", ANY_BUT_FATAL)
     }
 }
 

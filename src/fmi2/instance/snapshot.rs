@@ -194,4 +194,62 @@ impl<S: CoSimSlave> Instance<S> {
             terminate_requested,
         })
     }
+
+    /// `fmi2GetFMUstate` (new snapshot) — the caller boxes it or overwrites an old one.
+    pub fn snapshot(
+        &mut self,
+        function: &str,
+    ) -> std::result::Result<Snapshot<S::State>, fmi2Status> {
+        self.check_state(function, ANY_BUT_FATAL)?;
+        Ok(Snapshot {
+            magic: SNAPSHOT_MAGIC,
+            guid: self.slave.guid().to_string(),
+            slave: self.slave.get_state(),
+            machine: self.state,
+            terminate_requested: self.terminate_requested,
+        })
+    }
+
+    /// `fmi2SetFMUstate`: restores the slave and the calling-sequence state; the snapshot stays
+    /// valid.
+    pub fn restore(&mut self, snapshot: &Snapshot<S::State>) -> fmi2Status {
+        const F: &str = "fmi2SetFMUstate";
+        if let Err(s) = self.check_state(F, ANY_BUT_FATAL) {
+            return s;
+        }
+        if !snapshot.is_valid() {
+            return self.fail(
+                F,
+                "the FMU state is not a live state of this FMU (freed, or from another FMU)",
+            );
+        }
+        if snapshot.guid != self.slave.guid() {
+            return self.fail(
+                F,
+                &format!(
+                    "the FMU state belongs to an FMU with GUID {}, this instance has {}",
+                    snapshot.guid,
+                    self.slave.guid()
+                ),
+            );
+        }
+        match self.slave.set_state(&snapshot.slave) {
+            Ok(()) => {
+                self.state = snapshot.machine;
+                self.terminate_requested = snapshot.terminate_requested;
+                self.logger.event(&format!(
+                    "{F}: restored state {:?} at t = {}",
+                    self.state,
+                    self.slave.time()
+                ));
+                fmi2Status::fmi2OK
+            }
+            Err(e) => self.report(F, &e),
+        }
+    }
+
+    /// Checks the state for `fmi2FreeFMUstate`.
+    pub fn may_free_state(&mut self) -> std::result::Result<(), fmi2Status> {
+        self.check_state("fmi2FreeFMUstate", ANY_BUT_FATAL)
+    }
 }

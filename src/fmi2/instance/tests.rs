@@ -9,7 +9,7 @@ use crate::fmi2::logger::Sink;
 use crate::fmi2::types::{
     fmi2LastSuccessfulTime as LAST_SUCCESSFUL_TIME, fmi2Terminated as TERMINATED,
 };
-use crate::model::{BodyFile, Variability, VariableTable};
+use crate::model::{BodyFile, Causality, Variability, VariableTable, VariableType};
 use crate::Error;
 use std::cell::RefCell;
 use std::collections::HashMap;

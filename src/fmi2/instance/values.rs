@@ -1,8 +1,9 @@
 //! Typed access to the slave's variables for `fmi2Get*`/`fmi2Set*`, and which variables may be
 //! set in which state.
 
-use super::{CoSimSlave, MachineState, M};
+use super::{CoSimSlave, Instance, MachineState, GET, M, OUTPUT_DERIVATIVES, SET};
 use crate::error::Result;
+use crate::fmi2::types::fmi2Status;
 use crate::model::{Causality, Variability, Variable, VariableType};
 
 /// What a value getter returns for the C side.
@@ -102,5 +103,230 @@ pub fn settability_violation(state: MachineState, v: &Variable) -> Option<String
                 }
             )),
         },
+    }
+}
+
+impl<S: CoSimSlave> Instance<S> {
+    /// Looks up `vr` of type `ty`; the error names the value reference and, when it exists with
+    /// another type, that type.
+    fn lookup(&self, ty: VariableType, vr: u32) -> std::result::Result<&Variable, String> {
+        let table = self.slave.variables();
+        table.get(ty, vr).ok_or_else(|| {
+            let other = [
+                VariableType::Real,
+                VariableType::Integer,
+                VariableType::Boolean,
+                VariableType::String,
+            ]
+            .into_iter()
+            .find_map(|t| table.get(t, vr));
+            match other {
+                Some(v) => format!(
+                    "value reference {vr} is the {} variable {}, not a {} variable",
+                    type_name(v.ty),
+                    v.name,
+                    type_name(ty)
+                ),
+                None => format!("unknown {} value reference {vr}", type_name(ty)),
+            }
+        })
+    }
+
+    /// `fmi2Get{Real,Integer,Boolean}`: `values[i]` of `vrs[i]` (same length, checked by the
+    /// caller). Non-finite Reals are refused rather than passed on.
+    pub fn get_values<T: FromSlave<S> + Copy + std::fmt::Debug>(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &mut [T],
+    ) -> fmi2Status {
+        debug_assert_eq!(vrs.len(), values.len());
+        if let Err(s) = self.check_state(function, GET) {
+            return s;
+        }
+        for (&vr, out) in vrs.iter().zip(values.iter_mut()) {
+            let name = match self.lookup(T::TYPE, vr) {
+                Ok(v) => v.name.clone(),
+                Err(e) => return self.fail(function, &e),
+            };
+            match T::get(&mut self.slave, vr) {
+                Ok(x) if x.is_non_finite() => {
+                    return self.fail(function, &format!("{name} (value reference {vr}) is {x:?}"));
+                }
+                Ok(x) => *out = x,
+                Err(e) => return self.report(function, &e),
+            }
+        }
+        fmi2Status::fmi2OK
+    }
+
+    /// `fmi2Set{Real,Integer,Boolean}`: checks every value reference, its settability in the
+    /// current state and (Reals) its value before setting any value; then sets them in order
+    /// (the slave rejects bad values with a message naming the variable).
+    pub fn set_values<T: ToSlave<S>>(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &[T],
+    ) -> fmi2Status {
+        debug_assert_eq!(vrs.len(), values.len());
+        if let Err(s) = self.check_state(function, SET) {
+            return s;
+        }
+        for &vr in vrs {
+            let reason = match self.lookup(T::TYPE, vr) {
+                Ok(v) => settability_violation(self.state, v)
+                    .map(|r| format!("{r} (value reference {vr}, state {:?})", self.state)),
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(function, &reason);
+            }
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
+            if let Err(e) = T::check(&self.slave, vr, x) {
+                return self.report(function, &e);
+            }
+        }
+        for (&vr, &x) in vrs.iter().zip(values) {
+            if let Err(e) = T::set(&mut self.slave, vr, x) {
+                return self.report(function, &e);
+            }
+        }
+        fmi2Status::fmi2OK
+    }
+
+    /// `fmi2GetString`: the values of `vrs`, kept in the instance until its next
+    /// `fmi2GetString` (the caller hands out pointers into them). A value with a NUL byte is
+    /// refused.
+    pub fn get_strings(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+    ) -> (fmi2Status, &[std::ffi::CString]) {
+        if let Err(s) = self.check_state(function, GET) {
+            return (s, &[]);
+        }
+        let mut values = Vec::with_capacity(vrs.len());
+        for &vr in vrs {
+            if let Err(e) = self.lookup(VariableType::String, vr) {
+                return (self.fail(function, &e), &[]);
+            }
+            match self.slave.get_string(vr) {
+                Ok(text) => match std::ffi::CString::new(text) {
+                    Ok(c) => values.push(c),
+                    Err(_) => {
+                        let status = self.fail(
+                            function,
+                            &format!("String value reference {vr} holds a NUL character"),
+                        );
+                        return (status, &[]);
+                    }
+                },
+                Err(e) => return (self.report(function, &e), &[]),
+            }
+        }
+        self.strings = values;
+        (fmi2Status::fmi2OK, &self.strings)
+    }
+
+    /// `fmi2SetString`: like [`Self::set_values`]; a NULL string (None) is an error naming the
+    /// variable.
+    pub fn set_strings(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &[Option<String>],
+    ) -> fmi2Status {
+        debug_assert_eq!(vrs.len(), values.len());
+        if let Err(s) = self.check_state(function, SET) {
+            return s;
+        }
+        for (&vr, value) in vrs.iter().zip(values) {
+            let reason = match self.lookup(VariableType::String, vr) {
+                Ok(v) => settability_violation(self.state, v)
+                    .map(|r| format!("{r} (value reference {vr}, state {:?})", self.state))
+                    .or_else(|| {
+                        value
+                            .is_none()
+                            .then(|| format!("{} = NULL rejected: not a string", v.name))
+                    }),
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(function, &reason);
+            }
+        }
+        for (&vr, value) in vrs.iter().zip(values) {
+            if let Err(e) = self
+                .slave
+                .set_string(vr, value.as_deref().unwrap_or_default())
+            {
+                return self.report(function, &e);
+            }
+        }
+        fmi2Status::fmi2OK
+    }
+
+    /// `fmi2SetRealInputDerivatives` (`canInterpolateInputs="true"`): allowed where inputs may be
+    /// set; every value reference must be a Real input and every order 1 or 2 (what the slave
+    /// can use); all or nothing.
+    pub fn set_real_input_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &[f64],
+    ) -> fmi2Status {
+        const F: &str = "fmi2SetRealInputDerivatives";
+        if let Err(s) = self.check_state(F, SET) {
+            return s;
+        }
+        for (&vr, &order) in vrs.iter().zip(orders) {
+            let reason = match self.lookup(VariableType::Real, vr) {
+                Ok(v) if v.causality != Causality::Input => {
+                    Some(format!("{} (value reference {vr}) is not an input", v.name))
+                }
+                Ok(v) if order < 1 => Some(format!(
+                    "order = {order} rejected for {} (value reference {vr}): must be at least 1",
+                    v.name
+                )),
+                Ok(_) => None,
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(F, &reason);
+            }
+        }
+        match self.slave.set_real_input_derivatives(vrs, orders, values) {
+            Ok(()) => fmi2Status::fmi2OK,
+            Err(e) => self.report(F, &e),
+        }
+    }
+
+    /// `fmi2GetRealOutputDerivatives` (`maxOutputDerivativeOrder="2"`): every value reference
+    /// must be a Real output; the slave says which derivatives exist.
+    pub fn get_real_output_derivatives(
+        &mut self,
+        vrs: &[u32],
+        orders: &[i32],
+        values: &mut [f64],
+    ) -> fmi2Status {
+        const F: &str = "fmi2GetRealOutputDerivatives";
+        if let Err(s) = self.check_state(F, OUTPUT_DERIVATIVES) {
+            return s;
+        }
+        for ((&vr, &order), out) in vrs.iter().zip(orders).zip(values.iter_mut()) {
+            if let Err(e) = self.lookup(VariableType::Real, vr) {
+                return self.fail(F, &e);
+            }
+            match self.slave.get_real_output_derivative(vr, order) {
+                Ok(x) if x.is_finite() => *out = x,
+                Ok(x) => {
+                    return self.fail(F, &format!("the derivative of value reference {vr} is {x}"))
+                }
+                Err(e) => return self.report(F, &e),
+            }
+        }
+        fmi2Status::fmi2OK
     }
 }
