@@ -144,7 +144,7 @@ impl FeatureIndicators {
                                 for l in 0..MODES {
                                     case.mul_vec(&modes[l], &mut y);
                                     for j in 0..MODES {
-                                        g[k][j][l] = super::dot(&modes[j], &y);
+                                        g[k][j][l] = crate::linalg::dot(&modes[j], &y);
                                     }
                                 }
                             }

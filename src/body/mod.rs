@@ -18,7 +18,7 @@ pub use reduction::Reduction;
 use crate::fem::nonlinear::SvkSolid;
 use crate::linalg::dense::DenseSymmetric;
 use crate::linalg::sparse::BlockCsr3;
-use crate::linalg::SymmetricCsr;
+use crate::linalg::{dot, SymmetricCsr};
 use frame::{add_node, node, set_node};
 use nalgebra::{Matrix3, Vector3};
 
@@ -488,9 +488,4 @@ impl Body {
         self.internal_force(x, &zero, None, &mut scratch, &mut f)
             .strain_energy
     }
-}
-
-/// `a · b`.
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

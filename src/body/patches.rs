@@ -218,7 +218,7 @@ impl Patches {
                 set_node(ubar, k, &u);
             }
             patch.stiffness.mul_vec(ubar, g);
-            energy += 0.5 * super::dot(ubar, g);
+            energy += 0.5 * crate::linalg::dot(ubar, g);
             let z = if nonlinear_forces {
                 let mut mbar = Vector3::zeros();
                 for k in 0..fw.nodes.len() {
@@ -277,7 +277,7 @@ mod tests {
         let x: Vec<f64> = reference.iter().zip(&u).map(|(a, b)| a + b).collect();
         let mut f = vec![0.0; u.len()];
         let v = patches.internal_force(&x, true, &mut patches.scratch(), &mut f);
-        let linear = 0.5 * super::super::dot(&u, &ku);
+        let linear = 0.5 * crate::linalg::dot(&u, &ku);
         assert!(
             (v - linear).abs() < 1e-4 * linear,
             "patch energy {v} vs linear {linear}"

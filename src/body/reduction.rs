@@ -53,7 +53,7 @@ use super::interface::NodeSet;
 use crate::error::{Error, Result};
 use crate::fem::modal::lowest_eigenpairs;
 use crate::linalg::cholesky::SparseCholesky;
-use crate::linalg::SymmetricCsr;
+use crate::linalg::{dot, SymmetricCsr};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 /// Scalar fields from a vector mode whose mass norm is below this fraction of the mode's
@@ -420,7 +420,9 @@ impl Reduction {
                 row_major[i * s + k] = f[i];
             }
         }
-        let (lo, hi) = bounding_box(reference);
+        let (lo, hi) =
+            crate::mesh::bounding_box(reference.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
+        let (lo, hi) = (Vector3::from(lo), Vector3::from(hi));
         let size = (hi - lo).norm();
         for i in 0..n {
             let row = &row_major[i * s..(i + 1) * s];
@@ -630,19 +632,4 @@ fn dense_symmetric(a: &DMatrix<f64>) -> SymmetricCsr {
         }
     }
     SymmetricCsr::from_triplets(n, &triplets)
-}
-
-fn bounding_box(reference: &[f64]) -> (Vector3<f64>, Vector3<f64>) {
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for p in reference.chunks_exact(3) {
-        let p = Vector3::new(p[0], p[1], p[2]);
-        lo = lo.inf(&p);
-        hi = hi.sup(&p);
-    }
-    (lo, hi)
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

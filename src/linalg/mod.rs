@@ -11,3 +11,8 @@ pub mod sparse;
 
 pub use cholesky::SparseCholesky;
 pub use sparse::SymmetricCsr;
+
+/// The Euclidean inner product `aᵀ b` of two vectors of equal length.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}

@@ -242,15 +242,7 @@ impl Mesh {
 
     /// Smallest axis-aligned box holding all nodes: (min, max).
     pub fn bounding_box(&self) -> ([f64; 3], [f64; 3]) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in &self.nodes {
-            for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (lo, hi)
+        bounding_box(self.nodes.iter().copied())
     }
 }
 
@@ -342,4 +334,18 @@ mod hex20_tests {
         let e = Mesh::new(nodes, ElementKind::Hex20, conn).unwrap_err();
         assert!(e.message.contains("element 0 is inverted"), "{}", e.message);
     }
+}
+
+/// The smallest and largest coordinates of `points` (the corners of their axis-aligned bounding
+/// box), m.
+pub fn bounding_box(points: impl Iterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    (lo, hi)
 }
