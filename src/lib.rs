@@ -8,6 +8,7 @@
 #![deny(unsafe_code)]
 
 pub mod body;
+pub mod element;
 pub mod error;
 pub mod fem;
 #[allow(unsafe_code)]

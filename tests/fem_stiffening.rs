@@ -28,10 +28,10 @@
 //! The tolerance of the issue, 2 %, is thus about ten times the model error; the checks of the
 //! ratio `ω²(T)/ω²(0)` (which cancels the bending errors) are held to 0.5 %.
 
-use flexbody::fem::element::{jacobian, natural_coordinates, shape_functions, MAX_NODES};
+use flexbody::element::quadrature::gauss_legendre_1d;
+use flexbody::element::{jacobian, natural_coordinates, shape_functions, MAX_NODES};
 use flexbody::fem::geometric::{geometric_stiffness, stress_at_gauss_points, weighted_sum_into};
 use flexbody::fem::modal::lowest_eigenpairs;
-use flexbody::fem::quadrature::gauss_legendre_1d;
 use flexbody::fem::{scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;
 use flexbody::linalg::SymmetricCsr;

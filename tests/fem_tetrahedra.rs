@@ -4,8 +4,8 @@
 //! Meshes: `tests/data/*.msh`, made by `tests/data/make_meshes.py` (Gmsh). The tet4 meshes are
 //! the Kuhn-split boxes of `mesh::beam`.
 
-use flexbody::fem::element::{edges, integration_rule, physical_gradients, shape_functions};
-use flexbody::fem::element::{mass_rule, MAX_NODES};
+use flexbody::element::{edges, integration_rule, physical_gradients, shape_functions};
+use flexbody::element::{mass_rule, MAX_NODES};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;

@@ -7,9 +7,9 @@
 //! 4 for Tet10), the mass and the lumped masses that of [`mass_rule`] (the same for the
 //! hexahedra; 4 points for Tet4, 14 for Tet10).
 
-use super::element::{integration_rule, mass_rule, physical_gradients, shape_functions, MAX_NODES};
-use super::quadrature::QuadraturePoint;
 use super::IsotropicMaterial;
+use crate::element::quadrature::QuadraturePoint;
+use crate::element::{integration_rule, mass_rule, physical_gradients, shape_functions, MAX_NODES};
 use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 

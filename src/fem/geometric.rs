@@ -26,8 +26,8 @@
 //! cases value by value without looking at indices.
 
 pub use super::assembly::stiffness_pattern;
-use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use super::IsotropicMaterial;
+use crate::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 
@@ -282,7 +282,7 @@ pub fn weighted_sum_into(out: &mut SymmetricCsr, terms: &[(f64, &SymmetricCsr)])
 #[allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 mod tests {
     use super::*;
-    use crate::fem::element::{corner_count, edges};
+    use crate::element::{corner_count, edges};
     use crate::fem::stiffness_matrix;
     use crate::mesh::beam;
 

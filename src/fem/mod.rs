@@ -3,12 +3,10 @@
 //! DOF numbering everywhere: `3 * node + direction`.
 
 pub mod assembly;
-pub mod element;
 pub mod geometric;
 pub mod material;
 pub mod modal;
 pub mod nonlinear;
-pub mod quadrature;
 pub mod stress;
 
 pub use assembly::{

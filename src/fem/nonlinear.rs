@@ -29,8 +29,8 @@
 //! element block in the CSR values of `K`; the per-call routines use fixed-size stack arrays and
 //! do not allocate.
 
-use super::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use super::{stiffness_matrix, IsotropicMaterial};
+use crate::element::{integration_rule, physical_gradients, shape_functions, MAX_NODES};
 use crate::linalg::SymmetricCsr;
 use crate::mesh::{ElementKind, Mesh};
 

@@ -4,8 +4,8 @@
 //! von Mises equivalent stress `σ_v = sqrt(½((σ₁−σ₂)² + (σ₂−σ₃)² + (σ₃−σ₁)²))`, computed from the
 //! components as `sqrt(σ_xx² + σ_yy² + σ_zz² − σ_xxσ_yy − σ_yyσ_zz − σ_zzσ_xx + 3(σ_xy² + σ_yz² + σ_xz²))`.
 
-use super::element::{natural_coordinates, physical_gradients, shape_functions, MAX_NODES};
 use super::IsotropicMaterial;
+use crate::element::{natural_coordinates, physical_gradients, shape_functions, MAX_NODES};
 use crate::mesh::Mesh;
 
 /// Nodal-averaged small-strain stress (Pa, Voigt `[xx, yy, zz, yz, xz, xy]`) of the displacement

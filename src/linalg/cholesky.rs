@@ -2,7 +2,7 @@
 //! pattern, the numeric factorization once per step size, and solves that take their workspace so
 //! that a time step does not allocate.
 //!
-//! A dense matrix of moderate size (a reduced body's, [`crate::body::reduction`]) also keeps its
+//! A dense matrix of moderate size (a reduced body's) also keeps its
 //! explicit inverse `A⁻¹ = L⁻ᵀ L⁻¹`, computed from the factor: a solve is then one SIMD
 //! matrix–vector product instead of two triangular solves, whose dependency chain dominates at
 //! this size (n = 168: 4.3 µs against 11.4 µs). The iterations that use the solve converge to

@@ -1,8 +1,8 @@
 //! Structured meshes of boxes ("beams").
 
 use super::{ElementKind, Mesh};
+use crate::element::{natural_coordinates, TET_EDGES};
 use crate::error::{Error, Result};
-use crate::fem::element::{natural_coordinates, TET_EDGES};
 
 /// The 6 permutations of the axes: tetrahedron `p` of the Kuhn subdivision of the unit cube runs
 /// from corner `(0,0,0)` along `e_{π0}`, then `e_{π1}`, then `e_{π2}` to `(1,1,1)`.
@@ -190,7 +190,7 @@ mod tests {
 
     #[test]
     fn tetrahedra_fill_the_box_conformingly() {
-        use crate::fem::element::{mass_rule, physical_gradients, shape_functions, MAX_NODES};
+        use crate::element::{mass_rule, physical_gradients, shape_functions, MAX_NODES};
         for (kind, lattice) in [
             (ElementKind::Tet4, [4, 3, 4]),
             (ElementKind::Tet10, [7, 5, 7]),

@@ -4,7 +4,7 @@
 //!   10-node tetrahedra (Gmsh types 4 and 11) or 8- or 20-node hexahedra (types 5 and 17).
 //!   Gmsh's node order is VTK's except for Tet10 (Gmsh's local nodes 8 and 9, on edges 2-3 and
 //!   1-3, are VTK's 9 and 8) and Hex20 (mid-edge nodes in another edge order): both are permuted
-//!   to the VTK order of [`crate::fem::element`] here ([`TET10_FROM_GMSH`], [`HEX20_FROM_GMSH`]).
+//!   to the VTK order of [`crate::element`] here ([`TET10_FROM_GMSH`], [`HEX20_FROM_GMSH`]).
 //! * Nodes used by no volume element are dropped; the others are numbered by ascending Gmsh tag.
 //! * Every physical group (of any dimension: points, curves, surfaces, volumes) becomes a named
 //!   node set, the nodes of its elements: `$PhysicalNames` gives the names (a group without a

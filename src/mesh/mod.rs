@@ -8,47 +8,9 @@ pub use generator::beam;
 pub use selector::NodeSelector;
 
 use crate::error::{Error, Result};
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
-/// The element kinds the finite elements of [`crate::fem`] know.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ElementKind {
-    /// 8-node trilinear hexahedron (VTK_HEXAHEDRON node order).
-    Hex8,
-    /// 20-node serendipity hexahedron (VTK_QUADRATIC_HEXAHEDRON node order).
-    Hex20,
-    /// 4-node linear tetrahedron (VTK_TETRA node order).
-    Tet4,
-    /// 10-node quadratic tetrahedron (VTK_QUADRATIC_TETRA node order).
-    Tet10,
-}
-
-impl ElementKind {
-    /// Every element kind.
-    pub const ALL: [ElementKind; 4] = [
-        ElementKind::Hex8,
-        ElementKind::Hex20,
-        ElementKind::Tet4,
-        ElementKind::Tet10,
-    ];
-
-    /// Nodes per element.
-    pub fn node_count(self) -> usize {
-        match self {
-            ElementKind::Hex8 => 8,
-            ElementKind::Hex20 => 20,
-            ElementKind::Tet4 => 4,
-            ElementKind::Tet10 => 10,
-        }
-    }
-
-    /// Whether the shape functions are quadratic (mid-edge nodes: Hex20, Tet10).
-    pub fn is_quadratic(self) -> bool {
-        matches!(self, ElementKind::Hex20 | ElementKind::Tet10)
-    }
-}
+pub use crate::element::ElementKind;
 
 /// A validated mesh: reference node positions `X` (m), the connectivity of elements of one kind
 /// and named node sets (the physical groups of an imported mesh).
@@ -161,7 +123,7 @@ impl Mesh {
 
     /// The Jacobian determinant check of [`Mesh::new`].
     fn check_jacobians(&self) -> Result<()> {
-        use crate::fem::element::{
+        use crate::element::{
             mass_rule, natural_coordinates, physical_gradients, shape_functions, MAX_NODES,
         };
         let kind = self.kind;
@@ -252,7 +214,7 @@ mod tests {
 
     /// Unit cube Hex8 in VTK order.
     fn cube() -> Vec<[f64; 3]> {
-        crate::fem::element::HEX8_NODES
+        crate::element::HEX8_NODES
             .iter()
             .map(|p| [0.5 * (p[0] + 1.0), 0.5 * (p[1] + 1.0), 0.5 * (p[2] + 1.0)])
             .collect()

@@ -10,7 +10,7 @@ use std::fmt::Write as _;
 use std::io::{Seek, SeekFrom, Write};
 
 /// The VTK cell type of an element kind (node orders are VTK's already, see
-/// [`crate::fem::element`]).
+/// [`crate::element`]).
 pub fn cell_type(kind: ElementKind) -> u8 {
     match kind {
         ElementKind::Hex8 => 12,  // VTK_HEXAHEDRON

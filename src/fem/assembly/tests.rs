@@ -1,6 +1,6 @@
 #![allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 use super::*;
-use crate::fem::element::{edges, natural_coordinates};
+use crate::element::{edges, natural_coordinates};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::mesh::beam;
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -171,7 +171,7 @@ fn masses_sum_to_rho_v_and_hrz_is_positive() {
     let corner_row: f64 = ms.row(cube.element(0)[0]).1.iter().sum();
     assert!(corner_row < 0.0, "corner row sum {corner_row}");
     let tet = Mesh::new(
-        crate::fem::element::TET10_NODES.to_vec(),
+        crate::element::TET10_NODES.to_vec(),
         ElementKind::Tet10,
         (0..10).collect(),
     )

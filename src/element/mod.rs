@@ -1,3 +1,6 @@
+//! The reference finite elements (the floor below the mesh): element kinds ([`ElementKind`]),
+//! node orders, quadrature rules ([`quadrature`]) and shape functions.
+//!
 //! Shape functions of the hexahedra (natural coordinates `ξ = (ξ, η, ζ) ∈ [−1, 1]³`) and of the
 //! tetrahedra (natural coordinates in the unit tetrahedron `ξ, η, ζ ≥ 0, ξ + η + ζ ≤ 1`), the
 //! isoparametric Jacobian, physical shape-function gradients and the quadrature rule of each kind.
@@ -14,8 +17,49 @@
 //! Node order is VTK's (see [`natural_coordinates`]). All families are partitions of unity and
 //! reproduce linear fields, so an isoparametric element represents `u = A X + b` exactly.
 
-use super::quadrature::{hexahedron_rule, tetrahedron_rule, QuadraturePoint};
-use crate::mesh::ElementKind;
+pub mod quadrature;
+
+use quadrature::{hexahedron_rule, tetrahedron_rule, QuadraturePoint};
+use serde::{Deserialize, Serialize};
+
+/// The element kinds this crate knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElementKind {
+    /// 8-node trilinear hexahedron (VTK_HEXAHEDRON node order).
+    Hex8,
+    /// 20-node serendipity hexahedron (VTK_QUADRATIC_HEXAHEDRON node order).
+    Hex20,
+    /// 4-node linear tetrahedron (VTK_TETRA node order).
+    Tet4,
+    /// 10-node quadratic tetrahedron (VTK_QUADRATIC_TETRA node order).
+    Tet10,
+}
+
+impl ElementKind {
+    /// Every element kind.
+    pub const ALL: [ElementKind; 4] = [
+        ElementKind::Hex8,
+        ElementKind::Hex20,
+        ElementKind::Tet4,
+        ElementKind::Tet10,
+    ];
+
+    /// Nodes per element.
+    pub fn node_count(self) -> usize {
+        match self {
+            ElementKind::Hex8 => 8,
+            ElementKind::Hex20 => 20,
+            ElementKind::Tet4 => 4,
+            ElementKind::Tet10 => 10,
+        }
+    }
+
+    /// Whether the shape functions are quadratic (mid-edge nodes: Hex20, Tet10).
+    pub fn is_quadratic(self) -> bool {
+        matches!(self, ElementKind::Hex20 | ElementKind::Tet10)
+    }
+}
 
 /// Largest node count of an element kind (for fixed-size, allocation-free local arrays).
 pub const MAX_NODES: usize = 20;
