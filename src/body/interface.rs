@@ -3,10 +3,33 @@
 //! power-conjugate to it, and the resultant of nodal loads about the reference point.
 
 use super::frame::{add_node, node, set_node, Frame, FrameWeights};
-use super::reduction::{HeldCoordinate, Reduction};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::RefCell;
+
+/// A coordinate held by a boundary set: driven by the frame `(p, Q)` it is `p + Q d` (`point`)
+/// or `Q d` (a direction), `d` = `offset`; `p` is the set's reference point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeldCoordinate {
+    pub index: usize,
+    pub offset: Vector3<f64>,
+    pub point: bool,
+}
+
+/// The basis of a reduced body as a node set needs it: `S` (row-major `N × s`, node `i`'s row
+/// is `fields[i s .. (i+1) s]`) and the reference positions of the mesh nodes (flat `3N`, m).
+#[derive(Debug, Clone, Copy)]
+pub struct FieldBasis<'a> {
+    pub fields: &'a [f64],
+    pub field_count: usize,
+    pub mesh_reference: &'a [f64],
+}
+
+impl FieldBasis<'_> {
+    fn row(&self, i: usize) -> &[f64] {
+        &self.fields[i * self.field_count..(i + 1) * self.field_count]
+    }
+}
 
 /// A node set with positive weights `w_i` and a reference point.
 ///
@@ -22,7 +45,7 @@ pub struct NodeSet {
     pub frame_weights: FrameWeights,
     /// Reference point in reference coordinates (m).
     pub reference_point: Vector3<f64>,
-    /// On a reduced body ([`Reduction`]): how the set's nodes follow the body's coordinates.
+    /// On a reduced body ([`FieldBasis`]): how the set's nodes follow the body's coordinates.
     /// The vectors the methods take are then the reduced body's (flat `3s`).
     pub expansion: Option<Box<SetExpansion>>,
 }
@@ -90,9 +113,9 @@ impl NodeSet {
         })
     }
 
-    /// Puts the set on the reduced body `reduction`, holding `held` (empty for a loaded set);
+    /// Puts the set on the reduced body of basis `reduction`, holding `held` (empty for a loaded set);
     /// `None` puts it back on the mesh nodes.
-    pub fn set_reduction(&mut self, reduction: Option<(&Reduction, Vec<HeldCoordinate>)>) {
+    pub fn set_reduction(&mut self, reduction: Option<(FieldBasis, Vec<HeldCoordinate>)>) {
         let Some((reduction, held)) = reduction else {
             self.expansion = None;
             return;
@@ -121,7 +144,7 @@ impl NodeSet {
         let extent = fw
             .nodes
             .iter()
-            .map(|&i| (node(&reduction.mesh_reference, i) - fw.reference_centroid).norm())
+            .map(|&i| (node(reduction.mesh_reference, i) - fw.reference_centroid).norm())
             .fold(0.0, f64::max);
         let centred = (self.reference_point - fw.reference_centroid).norm() <= 1e-12 * extent;
         let force_weights = centred.then(|| {

@@ -49,7 +49,7 @@
 //! fixed support holds `a_j` coordinates exactly as it holds nodes on the full mesh.
 
 use super::frame::{node, FrameWeights};
-use super::interface::NodeSet;
+use super::interface::{FieldBasis, HeldCoordinate, NodeSet};
 use crate::error::{Error, Result};
 use crate::fem::modal::lowest_eigenpairs;
 use crate::linalg::cholesky::SparseCholesky;
@@ -70,15 +70,6 @@ pub const DEPENDENCE_CUTOFF: f64 = 1e-9;
 /// Relative tolerance of the subspace iteration for the fixed-interface modes (eigenvalues to
 /// about this, mode shapes to its square root: ample for a basis).
 pub const MODE_TOLERANCE: f64 = 1e-9;
-
-/// A coordinate held by a boundary set: driven by the frame `(p, Q)` it is `p + Q d` (`point`)
-/// or `Q d` (a direction), `d` = `offset`; `p` is the set's reference point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HeldCoordinate {
-    pub index: usize,
-    pub offset: Vector3<f64>,
-    pub point: bool,
-}
 
 /// The reduced body's basis and constant matrices.
 #[derive(Debug, Clone)]
@@ -523,6 +514,15 @@ impl Reduction {
     /// Row `S_i·` of node `i`.
     pub fn row(&self, i: usize) -> &[f64] {
         &self.fields[i * self.field_count..(i + 1) * self.field_count]
+    }
+
+    /// The basis as a node set needs it ([`NodeSet::set_reduction`]).
+    pub fn basis(&self) -> FieldBasis<'_> {
+        FieldBasis {
+            fields: &self.fields,
+            field_count: self.field_count,
+            mesh_reference: &self.mesh_reference,
+        }
     }
 
     /// The expanded nodal vector `x_i = Σ_k S_ik q_k` (flat `3N`) of a reduced vector `q`

@@ -302,7 +302,9 @@ impl Slave {
             } else {
                 Vec::new()
             };
-            interface.set.set_reduction(Some((&reduction, coordinates)));
+            interface
+                .set
+                .set_reduction(Some((reduction.basis(), coordinates)));
             if holds {
                 for k in interface.set.held_indices() {
                     clamped[k] = true;
