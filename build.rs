@@ -169,6 +169,9 @@ fn main() {
         .unwrap();
     }
     out.push_str("];\n\n");
+    for e in &spec.enumerations {
+        write_enumeration(&mut out, e);
+    }
     out.push_str("/// Log categories: name and description.\n");
     out.push_str("pub const LOG_CATEGORIES: &[(&str, &str)] = &[\n");
     for c in &spec.log_categories {
@@ -186,4 +189,74 @@ fn main() {
 
     let dest = std::path::Path::new(&std::env::var("OUT_DIR").unwrap()).join("fixed_variables.rs");
     std::fs::write(dest, out).expect("write fixed_variables.rs");
+}
+
+/// A Rust enum for an enumeration type of `variables.json`: one variant per item (the item's name
+/// with its first letter capitalised), valued 1, 2, ... as in the model description, the first
+/// item the default; `item`/`from_item` convert to and from the FMI Integer, `name` gives the
+/// item's name, serde reads and writes the name (the body file).
+fn write_enumeration(out: &mut String, e: &Enumeration) {
+    let variant = |name: &str| {
+        let mut c = name.chars();
+        let first = c.next().unwrap().to_ascii_uppercase();
+        format!("{first}{}", c.as_str())
+    };
+    writeln!(
+        out,
+        "/// {} (enumeration type `{}` of the model description).",
+        e.description, e.name
+    )
+    .unwrap();
+    writeln!(out, "#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize)]").unwrap();
+    writeln!(out, "pub enum {} {{", e.name).unwrap();
+    for (k, (name, description)) in e.items.iter().enumerate() {
+        writeln!(out, "    /// {description}").unwrap();
+        if k == 0 {
+            writeln!(out, "    #[default]").unwrap();
+        }
+        writeln!(out, "    #[serde(rename = {name:?})]").unwrap();
+        writeln!(out, "    {} = {},", variant(name), k + 1).unwrap();
+    }
+    out.push_str("}\n\n");
+    writeln!(out, "impl {} {{", e.name).unwrap();
+    writeln!(out, "    /// The FMI Integer of this item (1, 2, ...).").unwrap();
+    writeln!(
+        out,
+        "    pub fn item(self) -> i32 {{\n        self as i32\n    }}"
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "    /// The item of FMI Integer `item`, if there is one."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "    pub fn from_item(item: i32) -> Option<Self> {{\n        match item {{"
+    )
+    .unwrap();
+    for (k, (name, _)) in e.items.iter().enumerate() {
+        writeln!(
+            out,
+            "            {} => Some(Self::{}),",
+            k + 1,
+            variant(name)
+        )
+        .unwrap();
+    }
+    writeln!(out, "            _ => None,\n        }}\n    }}").unwrap();
+    writeln!(
+        out,
+        "    /// The item's name in the model description and the body file."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "    pub fn name(self) -> &'static str {{\n        match self {{"
+    )
+    .unwrap();
+    for (name, _) in &e.items {
+        writeln!(out, "            Self::{} => {name:?},", variant(name)).unwrap();
+    }
+    writeln!(out, "        }}\n    }}\n}}\n").unwrap();
 }

@@ -46,7 +46,7 @@
 //!   not axial.
 
 use super::frame::{node, set_node};
-use super::stiffening::{inertial_coefficients, Stiffening};
+use super::stiffening::{inertial_coefficients, GeometricStiffening};
 use super::strain_monitor::StrainMonitor;
 use super::Body;
 use crate::fem::modal::lowest_eigenpairs;
@@ -113,12 +113,12 @@ impl FeatureIndicators {
         free_stiffness: &SymmetricCsr,
         free_mass: &SymmetricCsr,
         supported: bool,
-        stiffening: Option<&Stiffening>,
+        stiffening: Option<&GeometricStiffening>,
     ) -> FeatureIndicators {
         let n3 = body.reference.len();
         let kind = stiffening.map(|s| match s {
-            Stiffening::Inertial { .. } => StiffeningKind::Inertial,
-            Stiffening::Stress { .. } => StiffeningKind::Stress,
+            GeometricStiffening::Inertial { .. } => StiffeningKind::Inertial,
+            GeometricStiffening::Stress { .. } => StiffeningKind::Stress,
         });
         let modal = if supported && free_stiffness.n >= MODES {
             lowest_eigenpairs(free_stiffness, free_mass, MODES, 1e-8, 200)
@@ -136,8 +136,9 @@ impl FeatureIndicators {
                             full
                         })
                         .collect();
-                    let unit_projections =
-                        stiffening.and_then(Stiffening::unit_cases).map(|cases| {
+                    let unit_projections = stiffening
+                        .and_then(GeometricStiffening::unit_cases)
+                        .map(|cases| {
                             let mut y = vec![0.0; n3];
                             let mut g = [[[0.0; MODES]; MODES]; 12];
                             for (k, case) in cases.iter().enumerate() {

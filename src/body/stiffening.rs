@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Which prestress drives the stiffening.
 #[derive(Debug, Clone)]
-pub enum Stiffening {
+pub enum GeometricStiffening {
     /// The 12 unit load cases' geometric stiffnesses.
     Inertial { unit_cases: Vec<SymmetricCsr> },
     /// Gauss-point stresses and the local deformation (scratch).
@@ -93,7 +93,7 @@ fn unit_field(k: usize, xb: &Vector3<f64>) -> Vector3<f64> {
     }
 }
 
-impl Stiffening {
+impl GeometricStiffening {
     /// `inertial` stiffening for `body` held at its `clamped` nodes (error for an unsupported
     /// body: its unit load cases would need inertia relief, which is not implemented).
     pub fn inertial(
@@ -101,7 +101,7 @@ impl Stiffening {
         material: &IsotropicMaterial,
         body: &Body,
         clamped: &[bool],
-    ) -> Result<Stiffening> {
+    ) -> Result<GeometricStiffening> {
         let free: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
         if free.len() == body.node_count() {
             return Err(Error::new(
@@ -134,12 +134,12 @@ impl Stiffening {
                 &stress_at_gauss_points(mesh, material, &u),
             ));
         }
-        Ok(Stiffening::Inertial { unit_cases })
+        Ok(GeometricStiffening::Inertial { unit_cases })
     }
 
     /// `stress` stiffening.
-    pub fn stress(mesh: &Mesh, body: &Body) -> Stiffening {
-        Stiffening::Stress {
+    pub fn stress(mesh: &Mesh, body: &Body) -> GeometricStiffening {
+        GeometricStiffening::Stress {
             stresses: vec![[0.0; 6]; gauss_point_count(mesh)],
             local_deformation: vec![0.0; body.reference.len()],
         }
@@ -148,8 +148,8 @@ impl Stiffening {
     /// The 12 unit load cases' geometric stiffnesses (`inertial` only).
     pub fn unit_cases(&self) -> Option<&[SymmetricCsr]> {
         match self {
-            Stiffening::Inertial { unit_cases } => Some(unit_cases),
-            Stiffening::Stress { .. } => None,
+            GeometricStiffening::Inertial { unit_cases } => Some(unit_cases),
+            GeometricStiffening::Stress { .. } => None,
         }
     }
 
@@ -171,13 +171,13 @@ impl Stiffening {
         k_g: &mut SymmetricCsr,
     ) {
         match self {
-            Stiffening::Inertial { unit_cases } => {
+            GeometricStiffening::Inertial { unit_cases } => {
                 let c = inertial_coefficients(body, x, v, a);
                 let terms: [(f64, &SymmetricCsr); 12] =
                     std::array::from_fn(|k| (c[k], &unit_cases[k]));
                 weighted_sum_into(k_g, &terms);
             }
-            Stiffening::Stress {
+            GeometricStiffening::Stress {
                 stresses,
                 local_deformation,
             } => {

@@ -201,20 +201,8 @@ pub struct SolverSpec {
     pub integrator: Integrator,
 }
 
-/// The time integration scheme (`solver.integrator`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "camelCase")]
-pub enum Integrator {
-    /// Implicit generalized-α (Arnold–Brüls): one constant factorization per step size.
-    #[default]
-    GeneralizedAlpha,
-    /// Explicit central difference with the lumped mass, the step limited by `2/ω_max`.
-    CentralDifference,
-    /// Implicit Radau IIA (3 stages, order 5, L-stable): one real and one complex constant
-    /// factorization per step size (`solver::radau`); reduced-strain formulation only.
-    #[serde(rename = "radauIIA")]
-    RadauIIA,
-}
+/// The time integration scheme (`solver.integrator`), the enumeration of `variables.json`.
+pub use super::variables::Integrator;
 
 impl SolverSpec {
     fn default_step_size() -> f64 {

@@ -1,13 +1,10 @@
 //! The assembled model for one set of parameters: body, free nodes, schemes and their
 //! factorization caches, built when the parameters it depends on change.
 
-use super::parameters::{
-    ModelKey, FORMULATION_FULL, INTEGRATOR_CENTRAL_DIFFERENCE, INTEGRATOR_RADAU,
-    STIFFENING_INERTIAL, STIFFENING_NONE, STIFFENING_STRESS,
-};
+use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
 use crate::body::feature_indicators::{self, FeatureIndicators};
-use crate::body::stiffening::Stiffening;
+use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{Body, BodyOptions, NodeSet, Patches, Reduction};
 use crate::error::{Error, Result};
@@ -15,6 +12,7 @@ use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::linalg::SymmetricCsr;
 use crate::model::category;
+use crate::model::variables::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
@@ -50,7 +48,7 @@ pub struct Features {
 
 /// The assembled model for one set of parameters.
 pub(super) struct Model {
-    pub(super) key: ModelKey,
+    pub(super) key: AssemblyKey,
     pub(super) body: Body,
     pub(super) free: FreeNodes,
     pub(super) scheme: GeneralizedAlpha,
@@ -58,7 +56,7 @@ pub(super) struct Model {
     pub(super) workspace: StepWorkspace,
     /// Geometric stiffening (`model.stiffening` inertial or stress); its `K_G` lives in
     /// `workspace.geometric_stiffness`.
-    pub(super) stiffening: Option<Stiffening>,
+    pub(super) stiffening: Option<GeometricStiffening>,
     /// The constant-mass solve for consistent accelerations (initialization, load jumps).
     pub(super) mass: ConsistentAcceleration,
     /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
@@ -145,7 +143,7 @@ struct MeshMatrices {
 impl Slave {
     /// Builds the model if the parameters it depends on changed (assembly and frames).
     pub(super) fn ensure_model(&mut self) -> Result<()> {
-        let key = self.parameters.model_key();
+        let key = self.parameters.assembly_key();
         if self.model.as_ref().is_some_and(|m| m.key == key) {
             return Ok(());
         }
@@ -194,9 +192,9 @@ impl Slave {
         if regions.is_empty() {
             return Ok(());
         }
-        let unsupported = if p.formulation == FORMULATION_FULL {
+        let unsupported = if p.formulation == Formulation::Full {
             Some("model.formulation = full")
-        } else if p.stiffening != STIFFENING_NONE {
+        } else if p.stiffening != Stiffening::None {
             Some("model.stiffening other than none")
         } else if p.frames > 1 {
             Some("model.frames > 1")
@@ -234,7 +232,7 @@ impl Slave {
             lumped.to_vec(),
             options,
         );
-        Ok(if p.formulation == FORMULATION_FULL {
+        Ok(if p.formulation == Formulation::Full {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
         } else if p.frames > 1 {
             body.with_patches(Patches::along_principal_axis(
@@ -318,7 +316,7 @@ impl Slave {
     /// stiffening, pins or hinges; anything else is an error naming the parameter.
     pub(super) fn check_reducible(&self) -> Result<()> {
         let p = &self.parameters;
-        let reason = if p.formulation == FORMULATION_FULL {
+        let reason = if p.formulation == Formulation::Full {
             Some(
                 "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
             )
@@ -327,16 +325,16 @@ impl Slave {
                 "model.frames = {}: a reduced body has one co-moving frame",
                 p.frames
             ))
-        } else if p.stiffening != STIFFENING_NONE {
+        } else if p.stiffening != Stiffening::None {
             Some(format!(
                 "model.stiffening = {}: geometric stiffening is not projected on the modes",
-                if p.stiffening == STIFFENING_INERTIAL {
+                if p.stiffening == Stiffening::Inertial {
                     "inertial"
                 } else {
                     "stress"
                 }
             ))
-        } else if p.integrator == INTEGRATOR_CENTRAL_DIFFERENCE {
+        } else if p.integrator == Integrator::CentralDifference {
             Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
         } else {
             self.interfaces
@@ -364,7 +362,7 @@ impl Slave {
     /// indicators, the schemes, the logs.
     pub(super) fn finish_model(
         &mut self,
-        key: ModelKey,
+        key: AssemblyKey,
         mut body: Body,
         clamped: Vec<bool>,
         lumped: &[f64],
@@ -375,17 +373,17 @@ impl Slave {
         let mut workspace =
             StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
         let stiffening = match p.stiffening {
-            STIFFENING_INERTIAL => Some(Stiffening::inertial(
+            Stiffening::Inertial => Some(GeometricStiffening::inertial(
                 &self.mesh,
                 &p.material,
                 &body,
                 &self.clamped,
             )?),
-            STIFFENING_STRESS => Some(Stiffening::stress(&self.mesh, &body)),
-            _ => None,
+            Stiffening::Stress => Some(GeometricStiffening::stress(&self.mesh, &body)),
+            Stiffening::None => None,
         };
         if stiffening.is_some() {
-            workspace.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
+            workspace.geometric_stiffness = Some(GeometricStiffening::pattern(&self.mesh));
         }
         let allowed = Features {
             nonlinear_forces: p.nonlinear_forces,
@@ -411,7 +409,7 @@ impl Slave {
         let radau = self.radau_model(&body, &free)?;
         let p = &self.parameters;
         let monitored =
-            p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
+            p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {
             key,
             radau,
@@ -463,11 +461,12 @@ impl Slave {
         &mut self,
         body: &Body,
         free: &FreeNodes,
-        stiffening: Option<&Stiffening>,
+        stiffening: Option<&GeometricStiffening>,
         allowed: Features,
     ) -> Option<FeatureIndicators> {
         let p = &self.parameters;
-        let single = p.formulation != FORMULATION_FULL && p.frames == 1 && body.reduction.is_none();
+        let single =
+            p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         if !(p.auto && single && (allowed.nonlinear_forces || allowed.stiffening)) {
             return None;
         }
@@ -518,7 +517,7 @@ impl Slave {
         free: &FreeNodes,
     ) -> Result<Option<CentralDifference>> {
         let p = &self.parameters;
-        if p.integrator != INTEGRATOR_CENTRAL_DIFFERENCE {
+        if p.integrator != Integrator::CentralDifference {
             return Ok(None);
         }
         let scheme = CentralDifference::new(body, lumped, free)?;
@@ -546,10 +545,10 @@ impl Slave {
     /// matrices hold the rotated small-strain stiffness: no tangent for the full formulation.
     fn radau_model(&self, body: &Body, free: &FreeNodes) -> Result<Option<RadauModel>> {
         let p = &self.parameters;
-        if p.integrator != INTEGRATOR_RADAU {
+        if p.integrator != Integrator::RadauIIA {
             return Ok(None);
         }
-        if p.formulation == FORMULATION_FULL {
+        if p.formulation == Formulation::Full {
             return Err(Error::new(
                 "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
             ));

@@ -3,29 +3,11 @@
 
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
-use crate::model::body_file::Integrator;
-use crate::model::variables::FixedKey;
+use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
 use crate::model::BodyFile;
 use crate::solver::anderson::MAX_DEPTH;
 
-/// `model.formulation` item of the full nonlinear reference.
-pub(super) const FORMULATION_FULL: i32 = 2;
-
-/// `model.stiffening` items.
-pub(super) const STIFFENING_NONE: i32 = 1;
-
-pub(super) const STIFFENING_INERTIAL: i32 = 2;
-
-pub(super) const STIFFENING_STRESS: i32 = 3;
-
-/// `solver.integrator` items.
-pub(super) const INTEGRATOR_GENERALIZED_ALPHA: i32 = 1;
-
-pub(super) const INTEGRATOR_CENTRAL_DIFFERENCE: i32 = 2;
-
-pub(super) const INTEGRATOR_RADAU: i32 = 3;
-
-/// The parameters of DESIGN.md section 4 (SI units).
+/// The parameters of the body (docs/fmu.md, "Parameters"; SI units).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Parameters {
     pub material: IsotropicMaterial,
@@ -45,18 +27,18 @@ pub struct Parameters {
     /// `model.auto`: with it `nonlinear_forces` and `stiffening` are what is allowed and the
     /// slave switches each on per step when its indicator says it matters (see [`Features`]).
     pub auto: bool,
-    /// `model.formulation`: 1 reducedStrain, 2 full.
-    pub formulation: i32,
-    /// `model.stiffening`: 1 none, 2 inertial, 3 stress.
-    pub stiffening: i32,
+    /// `model.formulation`.
+    pub formulation: Formulation,
+    /// `model.stiffening`.
+    pub stiffening: Stiffening,
     /// `model.frames`: co-moving frames of the reduced-strain body (≥ 1).
     pub frames: i32,
     /// `model.modes`: 0 the full mesh, `n > 0` the reduced body with `n` fixed-interface modes.
     pub modes: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
-    /// `solver.integrator`: 1 generalized-α, 2 central difference, 3 Radau IIA.
-    pub integrator: i32,
+    /// `solver.integrator`.
+    pub integrator: Integrator,
     /// `output.directory`: where VTK results go; empty: none (see [`crate::output`]).
     pub output_directory: String,
     /// `output.interval` (s): smallest time between saved results; 0: every communication point.
@@ -84,16 +66,12 @@ impl Parameters {
             max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
             nonlinear_forces: b.model.nonlinear_forces,
             auto: b.model.auto,
-            formulation: 1,
-            stiffening: 1,
+            formulation: Formulation::default(),
+            stiffening: Stiffening::default(),
             frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
             modes: b.model.modes.min(i32::MAX as u32) as i32,
             anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
-            integrator: match b.solver.integrator {
-                Integrator::GeneralizedAlpha => INTEGRATOR_GENERALIZED_ALPHA,
-                Integrator::CentralDifference => INTEGRATOR_CENTRAL_DIFFERENCE,
-                Integrator::RadauIIA => INTEGRATOR_RADAU,
-            },
+            integrator: b.solver.integrator,
             output_directory: String::new(),
             output_interval: 0.0,
         }
@@ -101,23 +79,20 @@ impl Parameters {
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
     /// placement, the step size and the iteration settings).
-    pub(super) fn model_key(&self) -> ModelKey {
-        (
-            self.material,
-            [
-                self.damping_alpha.to_bits(),
-                self.damping_beta.to_bits(),
-                self.rho_inf.to_bits(),
-            ],
-            [self.nonlinear_forces, self.auto],
-            [
-                self.formulation * 16 + self.stiffening,
-                self.frames,
-                self.anderson_depth,
-                self.integrator,
-                self.modes,
-            ],
-        )
+    pub(super) fn assembly_key(&self) -> AssemblyKey {
+        AssemblyKey {
+            material: self.material,
+            damping: [self.damping_alpha.to_bits(), self.damping_beta.to_bits()],
+            rho_inf: self.rho_inf.to_bits(),
+            nonlinear_forces: self.nonlinear_forces,
+            auto: self.auto,
+            formulation: self.formulation,
+            stiffening: self.stiffening,
+            frames: self.frames,
+            anderson_depth: self.anderson_depth,
+            integrator: self.integrator,
+            modes: self.modes,
+        }
     }
 
     /// Checks one Real parameter value; the error names the variable, the value and the reason.
@@ -147,22 +122,66 @@ impl Parameters {
     }
 }
 
-/// What the assembled model depends on (see [`Parameters::model_key`]).
-pub(super) type ModelKey = (IsotropicMaterial, [u64; 3], [bool; 2], [i32; 5]);
+/// What the assembled model depends on: the parameters of [`Parameters::assembly_key`] (reals
+/// by their bits, so that a model is rebuilt exactly when one of them changes).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct AssemblyKey {
+    material: IsotropicMaterial,
+    damping: [u64; 2],
+    rho_inf: u64,
+    nonlinear_forces: bool,
+    auto: bool,
+    formulation: Formulation,
+    stiffening: Stiffening,
+    frames: i32,
+    anderson_depth: i32,
+    integrator: Integrator,
+    modes: i32,
+}
 
 /// Where a parameter lives in [`Parameters`]: one of the four FMI types, borrowed shared (`R =
 /// &f64`, ...) or exclusive (`R = &mut f64`, ...).
-pub(super) enum Slot<R, I, B, T> {
+pub(super) enum Slot<R, I, B, T, C> {
     Real(R),
     Integer(I),
     Boolean(B),
     Text(T),
+    /// An Integer that is an enumeration (`variables.json`'s `enumerations`).
+    Choice(C),
 }
 
+/// An enumeration parameter as an FMI Integer.
+pub(super) trait Choice {
+    fn item(&self) -> i32;
+    /// Sets the item `item`; false (and nothing set) if there is none.
+    fn set_item(&mut self, item: i32) -> bool;
+}
+
+macro_rules! choice {
+    ($($t:ty),*) => {$(
+        impl Choice for $t {
+            fn item(&self) -> i32 {
+                <$t>::item(*self)
+            }
+            fn set_item(&mut self, item: i32) -> bool {
+                match <$t>::from_item(item) {
+                    Some(value) => {
+                        *self = value;
+                        true
+                    }
+                    None => false,
+                }
+            }
+        }
+    )*};
+}
+choice!(Formulation, Stiffening, Integrator);
+
 /// A parameter read through [`Parameters::slot`].
-pub(super) type SlotRef<'a> = Slot<&'a f64, &'a i32, &'a bool, &'a String>;
+pub(super) type SlotRef<'a> = Slot<&'a f64, &'a i32, &'a bool, &'a String, &'a dyn Choice>;
 /// A parameter written through [`Parameters::slot_mut`].
-pub(super) type SlotMut<'a> = Slot<&'a mut f64, &'a mut i32, &'a mut bool, &'a mut String>;
+pub(super) type SlotMut<'a> =
+    Slot<&'a mut f64, &'a mut i32, &'a mut bool, &'a mut String, &'a mut dyn Choice>;
 
 /// The one table from a fixed variable (`key`, component `c`) to its field of [`Parameters`],
 /// written once for the shared and the exclusive borrow (`$($m)?` is `mut` or nothing).
@@ -186,12 +205,12 @@ macro_rules! parameter_slot {
             Tolerance => Slot::Real(&$($m)? $p.tolerance),
             OutputInterval => Slot::Real(&$($m)? $p.output_interval),
             MaxIterations => Slot::Integer(&$($m)? $p.max_iterations),
-            Formulation => Slot::Integer(&$($m)? $p.formulation),
-            Stiffening => Slot::Integer(&$($m)? $p.stiffening),
+            Formulation => Slot::Choice(&$($m)? $p.formulation),
+            Stiffening => Slot::Choice(&$($m)? $p.stiffening),
             Frames => Slot::Integer(&$($m)? $p.frames),
             Modes => Slot::Integer(&$($m)? $p.modes),
             AndersonDepth => Slot::Integer(&$($m)? $p.anderson_depth),
-            Integrator => Slot::Integer(&$($m)? $p.integrator),
+            Integrator => Slot::Choice(&$($m)? $p.integrator),
             NonlinearForces => Slot::Boolean(&$($m)? $p.nonlinear_forces),
             Auto => Slot::Boolean(&$($m)? $p.auto),
             OutputDirectory => Slot::Text(&$($m)? $p.output_directory),
@@ -223,6 +242,7 @@ impl Parameters {
     pub(super) fn integer(&self, key: FixedKey) -> Option<i32> {
         match self.slot(key, 0)? {
             Slot::Integer(x) => Some(*x),
+            Slot::Choice(c) => Some(c.item()),
             _ => None,
         }
     }

@@ -23,7 +23,7 @@
 use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, INTERFACE_SLOTS};
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
-use crate::model::variables::FixedKey;
+use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
 use crate::solver::generalized_alpha::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
@@ -96,6 +96,15 @@ impl Reader<'_> {
     fn i32(&mut self, what: &str) -> Result<i32> {
         Ok(i32::from_le_bytes(self.take::<4>(what)?))
     }
+    /// An enumeration item (i32) read through `from_item`.
+    fn choice<T>(&mut self, what: &str, from_item: impl Fn(i32) -> Option<T>) -> Result<T> {
+        let item = self.i32(what)?;
+        from_item(item).ok_or_else(|| {
+            Error::new(format!(
+                "the serialized FMU state holds {item} for {what}: not an item of its enumeration"
+            ))
+        })
+    }
     fn u8(&mut self, what: &str) -> Result<u8> {
         Ok(self.take::<1>(what)?[0])
     }
@@ -133,11 +142,11 @@ impl SlaveState {
         w.f64s(&p.initial_angular_velocity);
         w.f64s(&[p.step_size, p.rho_inf, p.tolerance]);
         w.i32(p.max_iterations);
-        w.i32(p.formulation);
-        w.i32(p.stiffening);
+        w.i32(p.formulation.item());
+        w.i32(p.stiffening.item());
         w.i32(p.frames);
         w.i32(p.anderson_depth);
-        w.i32(p.integrator);
+        w.i32(p.integrator.item());
         w.i32(p.modes);
         w.u8(u8::from(p.nonlinear_forces));
         w.u8(u8::from(p.auto));
@@ -247,11 +256,11 @@ impl Slave {
         r.f64s(&mut solver, "solver parameters")?;
         [p.step_size, p.rho_inf, p.tolerance] = solver;
         p.max_iterations = r.i32("solver.maxIterations")?;
-        p.formulation = r.i32("model.formulation")?;
-        p.stiffening = r.i32("model.stiffening")?;
+        p.formulation = r.choice("model.formulation", Formulation::from_item)?;
+        p.stiffening = r.choice("model.stiffening", Stiffening::from_item)?;
         p.frames = r.i32("model.frames")?;
         p.anderson_depth = r.i32("solver.andersonDepth")?;
-        p.integrator = r.i32("solver.integrator")?;
+        p.integrator = r.choice("solver.integrator", Integrator::from_item)?;
         p.modes = r.i32("model.modes")?;
         p.nonlinear_forces = match r.u8("model.nonlinearForces")? {
             0 => false,
@@ -396,15 +405,6 @@ fn check_parameters(p: &Parameters) -> Result<()> {
             p.max_iterations,
             "must be at least 1",
         );
-    }
-    if !(1..=2).contains(&p.formulation) {
-        return bad("model.formulation", p.formulation, "not 1 or 2");
-    }
-    if !(1..=3).contains(&p.stiffening) {
-        return bad("model.stiffening", p.stiffening, "not 1, 2 or 3");
-    }
-    if !(1..=3).contains(&p.integrator) {
-        return bad("solver.integrator", p.integrator, "not 1, 2 or 3");
     }
     if p.frames < 1 {
         return bad("model.frames", p.frames, "must be at least 1");

@@ -227,6 +227,11 @@ impl Slave {
                 *x = value;
                 Ok(())
             }
+            // An item: check_integer has checked it against the enumeration.
+            Some(Slot::Choice(c)) => match c.set_item(value) {
+                true => Ok(()),
+                false => Err(Error::invalid_value(&v.name, value, "not an item")),
+            },
             _ => Err(Error::new(format!("{} cannot be set", v.name))),
         }
     }
