@@ -80,6 +80,7 @@ pub struct SlaveState {
     inputs: Vec<Inputs>,
     input_derivatives: Vec<InputDerivatives>,
     input_times: Vec<f64>,
+    last_step_size: f64,
     start_time: f64,
     dynamics: Option<Dynamics>,
     /// Internal steps, fixed-point iterations, retried internal steps.
@@ -122,6 +123,9 @@ pub struct Slave {
     /// Per interface, `t_0 − t_s` for the step under way (`t_0` its start): how far the
     /// inputs' extrapolation has run when the step begins. Scratch, sized once.
     input_ages: Vec<f64>,
+    /// The communication step last taken (0 before the first): a step within ulps of it is
+    /// taken as it (see `snapped_step`).
+    last_step_size: f64,
     /// The driving frames of motion interfaces at the start of the current step.
     driving: Vec<DrivingFrame>,
     start_time: f64,
@@ -212,6 +216,7 @@ impl Slave {
             input_derivatives: vec![[[0.0; INTERFACE_SLOTS]; 2]; n_interfaces],
             input_times: vec![0.0; n_interfaces],
             input_ages: vec![0.0; n_interfaces],
+            last_step_size: 0.0,
             driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
@@ -287,6 +292,7 @@ impl Slave {
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
         self.dynamics = None;
+        self.last_step_size = 0.0;
         self.input_times.fill(self.start_time);
         self.outputs.valid = false;
         Ok(())
@@ -391,6 +397,7 @@ impl Slave {
         }
         self.start_time = 0.0;
         self.input_times.fill(0.0);
+        self.last_step_size = 0.0;
         self.dynamics = None;
         self.backup = None;
         self.statistics = (0, 0);
@@ -406,6 +413,7 @@ impl Slave {
             inputs: self.inputs.clone(),
             input_derivatives: self.input_derivatives.clone(),
             input_times: self.input_times.clone(),
+            last_step_size: self.last_step_size,
             start_time: self.start_time,
             dynamics: self.dynamics.clone(),
             counters: [self.statistics.0, self.statistics.1, self.retries],
@@ -424,6 +432,7 @@ impl Slave {
         self.inputs.clone_from(&state.inputs);
         self.input_derivatives.clone_from(&state.input_derivatives);
         self.input_times.clone_from(&state.input_times);
+        self.last_step_size = state.last_step_size;
         self.start_time = state.start_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];

@@ -11,6 +11,7 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
+//! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries: u64 |
 //! | dynamics present | u8 (0 before initialization) |
@@ -156,6 +157,7 @@ impl SlaveState {
             w.f64s(&d[1]);
         }
         w.f64s(&self.input_times);
+        w.f64(self.last_step_size);
         w.f64(self.start_time);
         self.counters.iter().for_each(|&c| w.u64(c));
         match &self.dynamics {
@@ -210,6 +212,7 @@ impl Slave {
         }
         let mut input_times = vec![0.0; n];
         r.f64s(&mut input_times, "an input sample time")?;
+        let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;
         let counters = [
             r.u64("the step counter")?,
@@ -229,6 +232,7 @@ impl Slave {
             inputs,
             input_derivatives,
             input_times,
+            last_step_size,
             start_time,
             dynamics,
             counters,

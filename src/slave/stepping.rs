@@ -26,8 +26,9 @@ impl Slave {
         current_communication_point: f64,
         communication_step_size: f64,
     ) -> Result<()> {
-        let (t_c, big_h) = (current_communication_point, communication_step_size);
-        let (n, h) = self.internal_steps(t_c, big_h)?;
+        let t_c = current_communication_point;
+        let (n, h) = self.internal_steps(t_c, communication_step_size)?;
+        let big_h = self.snapped_step(communication_step_size);
         self.prepare_step(t_c, h)?;
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
@@ -47,10 +48,10 @@ impl Slave {
         }
         match result {
             Ok(()) => {
-                self.finish_step(t_c, big_h);
+                self.finish_step(t_c, big_h, communication_step_size);
                 Ok(())
             }
-            Err(e) => Err(self.roll_back(t_c, big_h, e)),
+            Err(e) => Err(self.roll_back(t_c, communication_step_size, e)),
         }
     }
 
@@ -90,7 +91,23 @@ impl Slave {
                 "needs more than 1e9 internal steps of solver.stepSize",
             ));
         }
-        Ok((substeps as usize, big_h / substeps))
+        Ok((substeps as usize, self.snapped_step(big_h) / substeps))
+    }
+
+    /// The communication step taken for `big_h`: importers that agree on the step compute it
+    /// differently (fmpy as the difference of two grid times, off by an ulp; a loop with exact
+    /// steps; OMSimulator's accumulated time), and the iteration's stopping point moves with
+    /// the last bit. A step within a few ulps (16 ε of `|t| + H`) of the last one taken, or of
+    /// a whole number of `solver.stepSize`, is taken as that step, so that the same inputs give
+    /// the same bits in every importer (docs/fmu.md, "The same numbers in every importer").
+    fn snapped_step(&self, big_h: f64) -> f64 {
+        let slack = 16.0 * f64::EPSILON * (self.time().abs() + big_h);
+        let s = self.parameters.step_size;
+        let grid = (big_h / s).round() * s;
+        [self.last_step_size, grid]
+            .into_iter()
+            .find(|&candidate| candidate > 0.0 && (big_h - candidate).abs() <= slack)
+            .unwrap_or(big_h)
     }
 
     /// Everything a communication step needs before its first internal step: the driving
@@ -128,11 +145,13 @@ impl Slave {
         Ok(())
     }
 
-    /// After a successful communication step: the time, the loads the end state's accelerations
-    /// belong to (the inputs extrapolated to `t_c + H`), the strain watch and the results.
-    fn finish_step(&mut self, t_c: f64, big_h: f64) {
+    /// After a successful communication step of `big_h` (the importer's step
+    /// `communication_step_size`): the time, the loads the end state's accelerations belong to
+    /// (the inputs extrapolated to `t_c + H`), the strain watch and the results.
+    fn finish_step(&mut self, t_c: f64, big_h: f64, communication_step_size: f64) {
+        self.last_step_size = big_h;
         let dynamics = self.dynamics.as_mut().unwrap();
-        dynamics.state.time = t_c + big_h;
+        dynamics.state.time = t_c + communication_step_size;
         dynamics.loads.clone_from(&self.inputs);
         for ((load, d), age) in dynamics
             .loads
@@ -144,7 +163,7 @@ impl Slave {
         }
         dynamics.gravity = self.parameters.gravity;
         self.outputs.valid = false;
-        self.watch_strain(t_c + big_h);
+        self.watch_strain(t_c + communication_step_size);
         if self.results.is_some() {
             self.write_results();
         }
