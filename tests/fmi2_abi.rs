@@ -1,5 +1,5 @@
 //! The exported FMI 2.0 functions called in-process, as an importer would, on the paths that do
-//! not reach the physics (`src/slave.rs`): strings, signatures, rejected instantiations, NULL
+//! not reach the physics (`src/slave/`): strings, signatures, rejected instantiations, NULL
 //! arguments. Tests with a working slave are in `tests/fmi2_slave.rs`.
 
 #![cfg(all(
@@ -156,8 +156,7 @@ fn missing_instance_name_or_guid_is_refused_with_a_message() {
     assert_eq!(recorder.take().len(), 4);
 }
 
-/// With the wrong GUID the result is NULL whatever the slave does: today the slave panics
-/// (`todo!()`), which must be caught and logged; once it works, the GUID comparison fails.
+/// With the wrong GUID the result is NULL with one error message; nothing panics.
 #[test]
 fn wrong_guid_gives_null_and_a_message_never_a_panic() {
     let recorder = Recorder::default();

@@ -1,7 +1,6 @@
-//! NEEDS THE SLAVE: the exported FMI 2.0 functions driving the real physics (`src/slave.rs`).
-//! Written against the fixed `Slave` API while its body was still `todo!()`; they are meant to
-//! pass once the slave works (run after merging). Paths without the slave are tested in
-//! `tests/fmi2_abi.rs`, the state machine itself in `src/fmi2/instance.rs`.
+//! The exported FMI 2.0 functions driving the real physics (`src/slave/`). Paths that do not
+//! reach the physics are tested in `tests/fmi2_abi.rs`, the state machine itself against a mock
+//! slave in `src/fmi2/instance/tests.rs`.
 //!
 //! Body: the embedded default (B1 cantilever, interfaces `root` (fixed, value references
 //! 1000..) and `tip` (force, 1100..)).

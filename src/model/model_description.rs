@@ -110,7 +110,7 @@ pub fn model_description(
     );
     let _ = writeln!(
         x,
-        // Capabilities: what src/fmi2 and src/slave.rs implement (MAX_OUTPUT_DERIVATIVE_ORDER = 2,
+        // Capabilities: what src/fmi2 and src/slave implement (MAX_OUTPUT_DERIVATIVE_ORDER = 2,
         // force-input derivatives up to order 2, serialized states).
         "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"true\" maxOutputDerivativeOrder=\"2\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
         a(MODEL_IDENTIFIER)
