@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
-use crate::model::BodyFile;
+use crate::model::{BodyFile, Target};
 use crate::solver::anderson::MAX_DEPTH;
 
 /// The parameters of the body (docs/fmu.md, "Parameters"; SI units).
@@ -228,6 +228,14 @@ impl Parameters {
     /// The field of the fixed variable `key` (component `c`) to write, `None` for outputs.
     pub(super) fn slot_mut(&mut self, key: FixedKey, c: usize) -> Option<SlotMut<'_>> {
         parameter_slot!(self, key, c, mut)
+    }
+
+    /// The field of a variable's `target` to write: `None` for inputs and outputs.
+    pub(super) fn target_mut(&mut self, target: Target) -> Option<SlotMut<'_>> {
+        match target {
+            Target::Fixed { key, component } => self.slot_mut(key, component),
+            Target::Interface { .. } => None,
+        }
     }
 
     /// The Real parameter `key` (component `c`), `None` for outputs and other types.

@@ -78,15 +78,12 @@ impl Slave {
     /// is reported when the results are first written).
     pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
         let v = self.lookup(VariableType::String, vr)?;
-        match v.target {
-            Target::Fixed { key, component } => match self.parameters.slot_mut(key, component) {
-                Some(Slot::Text(text)) => {
-                    value.clone_into(text);
-                    Ok(())
-                }
-                _ => Err(Error::new(format!("{} cannot be set", v.name))),
-            },
-            Target::Interface { .. } => Err(Error::new(format!("{} cannot be set", v.name))),
+        match self.parameters.target_mut(v.target) {
+            Some(Slot::Text(text)) => {
+                value.clone_into(text);
+                Ok(())
+            }
+            _ => Err(Error::new(format!("{} cannot be set", v.name))),
         }
     }
 
@@ -218,11 +215,7 @@ impl Slave {
     pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
         let v = self.lookup(VariableType::Integer, vr)?;
         self.check_integer(&v, value)?;
-        let slot = match v.target {
-            Target::Fixed { key, component } => self.parameters.slot_mut(key, component),
-            Target::Interface { .. } => None,
-        };
-        match slot {
+        match self.parameters.target_mut(v.target) {
             Some(Slot::Integer(x)) => {
                 *x = value;
                 Ok(())
@@ -292,11 +285,7 @@ impl Slave {
 
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
         let v = self.lookup(VariableType::Boolean, vr)?;
-        let slot = match v.target {
-            Target::Fixed { key, component } => self.parameters.slot_mut(key, component),
-            Target::Interface { .. } => None,
-        };
-        match slot {
+        match self.parameters.target_mut(v.target) {
             Some(Slot::Boolean(x)) => {
                 *x = value;
                 Ok(())
