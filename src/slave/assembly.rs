@@ -16,9 +16,8 @@ use crate::fem::{self, IsotropicMaterial};
 use crate::model::InterfaceKind;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
-use crate::solver::generalized_alpha::{
-    FreeNodes, GeneralizedAlpha, IterationMatrix, StepWorkspace,
-};
+use crate::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix, StepWorkspace};
+use crate::solver::problem::{FreeNodes, ResidualWorkspace};
 use crate::solver::radau::{RadauIIA, RadauMatrix, RadauWorkspace};
 use nalgebra::Vector3;
 
@@ -53,17 +52,20 @@ pub(super) struct Model {
     pub(super) free: FreeNodes,
     pub(super) scheme: GeneralizedAlpha,
     pub(super) matrices: Vec<IterationMatrix>,
+    /// Generalized-α's work vectors.
     pub(super) workspace: StepWorkspace,
+    /// The residual's work vectors, force scratch and geometric stiffness, shared by whichever
+    /// scheme steps the model (and read by the strain watch and the outputs).
+    pub(super) forces: ResidualWorkspace,
     /// Geometric stiffening (`model.stiffening` inertial or stress); its `K_G` lives in
-    /// `workspace.geometric_stiffness`.
+    /// `forces.geometric_stiffness`.
     pub(super) stiffening: Option<Stiffening>,
     /// The constant-mass solve for consistent accelerations (initialization, load jumps).
     pub(super) mass: ConsistentAcceleration,
     /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
     pub(super) explicit: Option<CentralDifference>,
     /// Radau IIA (`solver.integrator = radauIIA`), if chosen: its factorization cache (used in
-    /// place of `matrices`) and workspace. Its residual shares `workspace`'s force scratch and
-    /// geometric stiffness.
+    /// place of `matrices`) and workspace. Its residual uses `forces`.
     pub(super) radau: Option<RadauModel>,
     /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
     pub(super) strain_monitor: Option<(StrainMonitor, bool)>,
@@ -71,7 +73,7 @@ pub(super) struct Model {
     pub(super) indicators: Option<FeatureIndicators>,
     /// The allowed terms: upper bounds of [`Features`].
     pub(super) allowed: Features,
-    /// `K_G` while stiffening is switched off (it moves to `workspace.geometric_stiffness` and
+    /// `K_G` while stiffening is switched off (it moves to `forces.geometric_stiffness` and
     /// back: no allocation).
     pub(super) parked_geometric_stiffness: Option<crate::linalg::SymmetricCsr>,
 }
@@ -83,10 +85,10 @@ impl Model {
     /// the fixed-point/Anderson iteration; so a switch never refactorises.
     pub(super) fn apply_features(&mut self, features: Features) {
         self.body.options.nonlinear_forces = features.nonlinear_forces;
-        let active = self.workspace.geometric_stiffness.is_some();
+        let active = self.forces.geometric_stiffness.is_some();
         if features.stiffening != active {
             std::mem::swap(
-                &mut self.workspace.geometric_stiffness,
+                &mut self.forces.geometric_stiffness,
                 &mut self.parked_geometric_stiffness,
             );
         }
@@ -343,8 +345,8 @@ impl Slave {
                 )?;
             }
         }
-        let mut workspace =
-            StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
+        let workspace = StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
+        let mut forces = ResidualWorkspace::new(&body);
         let stiffening = match p.stiffening {
             STIFFENING_INERTIAL => Some(Stiffening::inertial(
                 &self.mesh,
@@ -356,7 +358,7 @@ impl Slave {
             _ => None,
         };
         if stiffening.is_some() {
-            workspace.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
+            forces.geometric_stiffness = Some(Stiffening::pattern(&self.mesh));
         }
         // model.auto: indicators for the allowed terms of the one-frame reduced-strain body
         // (patches and the full formulation have no switchable terms: forced as given).
@@ -478,6 +480,7 @@ impl Slave {
             strain_monitor: monitored.then(|| (StrainMonitor::new(&self.mesh), false)),
             free,
             workspace,
+            forces,
             stiffening,
             indicators,
             allowed,

@@ -8,7 +8,8 @@ use super::{Dynamics, Slave};
 use crate::body::frame::nearest_rotation;
 use crate::error::{Error, Result};
 use crate::model::InterfaceKind;
-use crate::solver::generalized_alpha::{self, DynamicState};
+use crate::solver::generalized_alpha;
+use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 impl Slave {
@@ -165,12 +166,12 @@ impl Slave {
             &model.free,
             &loads,
             &mut state,
-            &mut model.workspace,
+            &mut model.forces,
             &mut model.mass,
         )?;
         if let Some(explicit) = &model.explicit {
             // The explicit scheme's accelerations belong to the lumped mass.
-            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.workspace);
+            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.forces);
         }
         self.dynamics = Some(Dynamics {
             state,

@@ -8,7 +8,7 @@ use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
 use crate::model::variables::InterfaceQuantity;
 use crate::model::InterfaceKind;
-use crate::solver::generalized_alpha::DynamicState;
+use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// An interface at run time: its kind and node set.

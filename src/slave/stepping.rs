@@ -5,7 +5,8 @@ use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
 use super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
-use crate::solver::generalized_alpha::{self, DynamicState, IterationSettings};
+use crate::solver::generalized_alpha;
+use crate::solver::problem::{DynamicState, IterationSettings, StepProblem};
 use crate::solver::radau::{self, RadauProblem};
 use nalgebra::Vector3;
 
@@ -75,7 +76,7 @@ impl Slave {
         );
         if let (Some(stiffening), Some(k_g)) = (
             model.stiffening.as_mut(),
-            model.workspace.geometric_stiffness.as_mut(),
+            model.forces.geometric_stiffness.as_mut(),
         ) {
             let s = &dynamics.state;
             stiffening.update(
@@ -126,8 +127,8 @@ impl Slave {
                 // crossing; again after it fell below half of it).
                 let model = self.model.as_mut().expect("the model exists after a step");
                 if let Some((monitor, above)) = &mut model.strain_monitor {
-                    let g = monitor
-                        .largest_gradient(model.workspace.force_scratch().local_deformation());
+                    let g =
+                        monitor.largest_gradient(model.forces.force_scratch().local_deformation());
                     if g > DEFAULT_THRESHOLD && !*above {
                         *above = true;
                         self.events.push(LogEvent {
@@ -274,7 +275,7 @@ impl Slave {
         let prescribe = |t: f64, state: &mut DynamicState| {
             prescribe_motion(body, interfaces, driving, t - t_c, state)
         };
-        let problem = generalized_alpha::StepProblem {
+        let problem = StepProblem {
             body,
             free: &model.free,
             loads: &loads,
@@ -299,7 +300,7 @@ impl Slave {
             });
             let report = match (&model.explicit, &mut model.radau) {
                 (Some(explicit), _) => {
-                    explicit.step(&problem, hs, &mut dynamics.state, &mut model.workspace)?
+                    explicit.step(&problem, hs, &mut dynamics.state, &mut model.forces)?
                 }
                 (None, Some(radau)) => radau::step(
                     &radau_problem,
@@ -308,7 +309,7 @@ impl Slave {
                     hs,
                     &mut dynamics.state,
                     &mut radau.workspace,
-                    &mut model.workspace,
+                    &mut model.forces,
                 )?,
                 (None, None) => generalized_alpha::step(
                     &problem,
@@ -317,6 +318,7 @@ impl Slave {
                     hs,
                     &mut dynamics.state,
                     &mut model.workspace,
+                    &mut model.forces,
                 )?,
             };
             self.statistics.0 += 1;
