@@ -19,8 +19,11 @@ use flexbody::mesh::{generator, ElementKind};
 use flexbody::solver::central_difference::CentralDifference;
 use flexbody::solver::consistent_acceleration::ConsistentAcceleration;
 use flexbody::solver::generalized_alpha::{
-    self, initial_acceleration, last_residual, residual, DynamicState, FreeNodes, GeneralizedAlpha,
-    IterationMatrix, IterationSettings, StepProblem, StepWorkspace,
+    self, initial_acceleration, GeneralizedAlpha, IterationMatrix, StepWorkspace,
+};
+use flexbody::solver::problem::{
+    last_residual, residual, DynamicState, FreeNodes, IterationSettings, ResidualWorkspace,
+    StepProblem,
 };
 
 const PULSE: f64 = 0.02;
@@ -102,6 +105,7 @@ fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
     let scheme = GeneralizedAlpha::new(rho_inf);
     let mut matrix = IterationMatrix::new(&c.body, &c.free, &scheme, h, 0.0, 0.0).unwrap();
     let mut ws = StepWorkspace::new(&c.body, &c.free);
+    let mut forces = ResidualWorkspace::new(&c.body);
     let mut state = initial_state(c);
     let mut mass = ConsistentAcceleration::new(&c.free).unwrap();
     initial_acceleration(
@@ -109,7 +113,7 @@ fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
         &c.free,
         &load(c, 0.0),
         &mut state,
-        &mut ws,
+        &mut forces,
         &mut mass,
     )
     .unwrap();
@@ -121,7 +125,8 @@ fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
     for n in 1..=((2.0 * PULSE / h).round() as usize) {
         let loads = load(c, n as f64 * h);
         let problem = c.problem(&loads);
-        generalized_alpha::step(&problem, &mut matrix, &settings, h, &mut state, &mut ws).unwrap();
+        let (state, ws, forces) = (&mut state, &mut ws, &mut forces);
+        generalized_alpha::step(&problem, &mut matrix, &settings, h, state, ws, forces).unwrap();
         if n % m == 0 {
             tip.push(c.tip_deflection(&state.position));
         }
@@ -159,12 +164,13 @@ fn a_load_jump_restarts_from_consistent_accelerations() {
     // on the free DOFs, as it did for the old loads before (to the mass solve's round-off).
     let c = cantilever();
     let mut ws = StepWorkspace::new(&c.body, &c.free);
+    let mut forces = ResidualWorkspace::new(&c.body);
     let mut state = initial_state(&c);
     let mut mass = ConsistentAcceleration::new(&c.free).unwrap();
     let (old, new) = (load(&c, 0.25 * PULSE), load(&c, 0.5 * PULSE));
-    initial_acceleration(&c.body, &c.free, &old, &mut state, &mut ws, &mut mass).unwrap();
+    initial_acceleration(&c.body, &c.free, &old, &mut state, &mut forces, &mut mass).unwrap();
     let scale = 10.0;
-    let free_residual = |ws: &StepWorkspace| {
+    let free_residual = |ws: &ResidualWorkspace| {
         let r = last_residual(ws);
         c.free
             .nodes
@@ -172,20 +178,23 @@ fn a_load_jump_restarts_from_consistent_accelerations() {
             .flat_map(|&i| 3 * i..3 * i + 3)
             .fold(0.0_f64, |m, d| m.max(r[d].abs()))
     };
-    residual(&c.body, &c.free, &state, &old, &mut ws);
-    assert!(free_residual(&ws) < 1e-9 * scale);
-    residual(&c.body, &c.free, &state, &new, &mut ws);
+    residual(&c.body, &c.free, &state, &old, &mut forces);
+    assert!(free_residual(&forces) < 1e-9 * scale);
+    residual(&c.body, &c.free, &state, &new, &mut forces);
     // The jump: 5 N spread over the tip nodes.
     assert!(
-        free_residual(&ws) > 0.5 * 5.0 / c.tip.len() as f64,
+        free_residual(&forces) > 0.5 * 5.0 / c.tip.len() as f64,
         "the loads did jump"
     );
-    generalized_alpha::restart_for_load_change(&c.free, &mut mass, &old, &new, &mut state, &mut ws);
-    residual(&c.body, &c.free, &state, &new, &mut ws);
+    let (state_ref, forces_ref) = (&mut state, &mut forces);
+    generalized_alpha::restart_for_load_change(
+        &c.free, &mut mass, &old, &new, state_ref, forces_ref, &mut ws,
+    );
+    residual(&c.body, &c.free, &state, &new, &mut forces);
     assert!(
-        free_residual(&ws) < 1e-9 * scale,
+        free_residual(&forces) < 1e-9 * scale,
         "{:e}",
-        free_residual(&ws)
+        free_residual(&forces)
     );
     assert_eq!(state.acceleration, state.pseudo_acceleration);
 }
@@ -215,7 +224,7 @@ fn central_difference_critical_step_matches_the_highest_eigenvalue() {
 
 /// Central difference on the coarse cantilever: tip deflection at every 1 ms up to 2T.
 fn run_explicit(c: &Cantilever, scheme: &CentralDifference, h: f64) -> Vec<f64> {
-    let mut ws = StepWorkspace::new(&c.body, &c.free);
+    let mut ws = ResidualWorkspace::new(&c.body);
     let mut state = initial_state(c);
     let per_ms = (1e-3 / h).round() as usize;
     let mut tip = Vec::new();
@@ -251,7 +260,7 @@ fn central_difference_is_second_order_and_refuses_an_unstable_step() {
         assert!((1.8..=2.2).contains(p), "order {p:.2}");
     }
     // A step above the stable one is refused (Discard), the state untouched.
-    let mut ws = StepWorkspace::new(&c.body, &c.free);
+    let mut ws = ResidualWorkspace::new(&c.body);
     let mut state = initial_state(&c);
     let before = state.clone();
     let loads = load(&c, 0.0);

@@ -12,9 +12,7 @@ use common::*;
 use flexbody::body::{Body, BodyOptions};
 use flexbody::fem::{self, IsotropicMaterial};
 use flexbody::mesh::{generator, ElementKind};
-use flexbody::solver::generalized_alpha::{
-    DynamicState, FreeNodes, IterationSettings, StepWorkspace,
-};
+use flexbody::solver::problem::{DynamicState, FreeNodes, IterationSettings, ResidualWorkspace};
 use flexbody::solver::radau::{self, RadauIIA, RadauMatrix, RadauProblem, RadauWorkspace};
 
 const PULSE: f64 = 0.02;
@@ -75,7 +73,7 @@ fn run_from(
     let h = big_h / m as f64;
     let mut matrix = RadauMatrix::new(&c.body, &c.free, &RadauIIA::new(), h, 0.0, 0.0).unwrap();
     let mut ws = RadauWorkspace::new(&c.body, &c.free);
-    let mut forces = StepWorkspace::new(&c.body, &c.free);
+    let mut forces = ResidualWorkspace::new(&c.body);
     let n3 = c.body.reference.len();
     // Starts undeformed with zero load: the initial acceleration is zero.
     let mut state = DynamicState {

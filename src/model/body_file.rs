@@ -218,7 +218,7 @@ impl SolverSpec {
         25
     }
     fn default_anderson_depth() -> u32 {
-        crate::solver::generalized_alpha::DEFAULT_ANDERSON_DEPTH as u32
+        crate::solver::anderson::DEFAULT_DEPTH as u32
     }
 }
 

@@ -16,26 +16,11 @@ use crate::model::variables::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
-use crate::solver::generalized_alpha::{
-    FreeNodes, GeneralizedAlpha, IterationMatrix, StepWorkspace,
-};
-use crate::solver::radau::{RadauIIA, RadauMatrix, RadauWorkspace};
+use crate::solver::generalized_alpha::{GeneralizedAlpha, StepWorkspace};
+use crate::solver::integrator::{Damping, FactorCache, TimeIntegrator};
+use crate::solver::problem::{FreeNodes, ResidualWorkspace};
+use crate::solver::radau::{RadauIIA, RadauWorkspace};
 use nalgebra::Vector3;
-
-/// Most factorizations kept, one per internal step size in use, least recently used evicted.
-///
-/// Memory: each entry holds the sparse Cholesky factor of the free DOFs' iteration matrix plus
-/// its solve workspace (and, with pins or hinges, the small dense Schur complement). For the
-/// default body (621 nodes, 1 800 free DOF) the factor holds 223 083 values (1.8 MB, about 3 MB
-/// with its indices); the cache is bounded by four of them whatever sequence of communication
-/// step sizes the importer sends (`tests/fmi2_capabilities.rs` checks the bound). With
-/// `radauIIA` an entry holds that Cholesky factor and a complex (`c64`) LU factor of the same
-/// matrix size besides (pivoting, COLAMD ordering: it is larger; factorization measured 3–6 ×
-/// the Cholesky's time), so a Radau entry costs several times a generalized-α one.
-/// Four covers a steady step size, a last partial step and the three step sizes of the retries
-/// of a failed internal step ([`MAX_STEP_HALVINGS`]); a fifth size evicts the least recently used
-/// one, which is factorised again when it comes back.
-pub const MATRIX_CACHE_SIZE: usize = 4;
 
 /// The terms in force during a step: with `model.auto` chosen per communication step by
 /// [`FeatureIndicators`] among the allowed ones, otherwise the forced switches. Part of the
@@ -51,27 +36,23 @@ pub(super) struct Model {
     pub(super) key: AssemblyKey,
     pub(super) body: Body,
     pub(super) free: FreeNodes,
-    pub(super) scheme: GeneralizedAlpha,
-    pub(super) matrices: Vec<IterationMatrix>,
-    pub(super) workspace: StepWorkspace,
+    /// The scheme of `solver.integrator` with its factorizations per step size.
+    pub(super) integrator: TimeIntegrator,
+    /// The residual's work vectors, force scratch and geometric stiffness, shared by whichever
+    /// scheme steps the model (and read by the strain watch and the outputs).
+    pub(super) forces: ResidualWorkspace,
     /// Geometric stiffening (`model.stiffening` inertial or stress); its `K_G` lives in
-    /// `workspace.geometric_stiffness`.
+    /// `forces.geometric_stiffness`.
     pub(super) stiffening: Option<GeometricStiffening>,
     /// The constant-mass solve for consistent accelerations (initialization, load jumps).
     pub(super) mass: ConsistentAcceleration,
-    /// The explicit scheme (`solver.integrator = centralDifference`), if chosen.
-    pub(super) explicit: Option<CentralDifference>,
-    /// Radau IIA (`solver.integrator = radauIIA`), if chosen: its factorization cache (used in
-    /// place of `matrices`) and workspace. Its residual shares `workspace`'s force scratch and
-    /// geometric stiffness.
-    pub(super) radau: Option<RadauModel>,
     /// The watch on `‖∇ū‖` (one co-moving frame only) and whether it is above the threshold.
     pub(super) strain_monitor: Option<(StrainMonitor, bool)>,
     /// `model.auto`'s indicators (one co-moving frame, reduced strain, some term allowed).
     pub(super) indicators: Option<FeatureIndicators>,
     /// The allowed terms: upper bounds of [`Features`].
     pub(super) allowed: Features,
-    /// `K_G` while stiffening is switched off (it moves to `workspace.geometric_stiffness` and
+    /// `K_G` while stiffening is switched off (it moves to `forces.geometric_stiffness` and
     /// back: no allocation).
     pub(super) parked_geometric_stiffness: Option<crate::linalg::SymmetricCsr>,
 }
@@ -83,53 +64,14 @@ impl Model {
     /// the fixed-point/Anderson iteration; so a switch never refactorises.
     pub(super) fn apply_features(&mut self, features: Features) {
         self.body.options.nonlinear_forces = features.nonlinear_forces;
-        let active = self.workspace.geometric_stiffness.is_some();
+        let active = self.forces.geometric_stiffness.is_some();
         if features.stiffening != active {
             std::mem::swap(
-                &mut self.workspace.geometric_stiffness,
+                &mut self.forces.geometric_stiffness,
                 &mut self.parked_geometric_stiffness,
             );
         }
     }
-}
-
-/// Radau IIA's part of the model.
-pub(super) struct RadauModel {
-    pub(super) tableau: RadauIIA,
-    pub(super) matrices: Vec<RadauMatrix>,
-    pub(super) workspace: RadauWorkspace,
-}
-
-/// Index of the factorization for step `h` in `cache`, most recently used last (a rotation of
-/// at most [`MATRIX_CACHE_SIZE`] entries: no allocation on a hit). On a miss `factorise()` builds
-/// it, the least recently used (the first) is evicted when the cache is full, and
-/// `describe(matrix, seconds)` is logged under `logEvents`.
-pub(super) fn cached_factorization<T>(
-    cache: &mut Vec<T>,
-    h: f64,
-    step_size: impl Fn(&T) -> f64,
-    factorise: impl FnOnce() -> Result<T>,
-    describe: impl Fn(&T, f64) -> String,
-    events: &mut Vec<LogEvent>,
-) -> Result<usize> {
-    if let Some(i) = cache
-        .iter()
-        .position(|m| (step_size(m) - h).abs() <= 1e-9 * h)
-    {
-        cache[i..].rotate_left(1);
-        return Ok(cache.len() - 1);
-    }
-    let started = std::time::Instant::now();
-    let matrix = factorise()?;
-    events.push(LogEvent {
-        category: category::EVENTS,
-        message: describe(&matrix, started.elapsed().as_secs_f64()),
-    });
-    if cache.len() >= MATRIX_CACHE_SIZE {
-        cache.remove(0);
-    }
-    cache.push(matrix);
-    Ok(cache.len() - 1)
 }
 
 /// The matrices of the reference mesh: positions `X` (flat `3N`), the scalar mass matrix `Ms`
@@ -370,8 +312,7 @@ impl Slave {
         let started = std::time::Instant::now();
         let free = self.constrained_free_nodes(&body, &clamped)?;
         let p = &self.parameters;
-        let mut workspace =
-            StepWorkspace::with_anderson_depth(&body, &free, p.anderson_depth as usize);
+        let mut forces = ResidualWorkspace::new(&body);
         let stiffening = match p.stiffening {
             Stiffening::Inertial => Some(GeometricStiffening::inertial(
                 &self.mesh,
@@ -383,7 +324,7 @@ impl Slave {
             Stiffening::None => None,
         };
         if stiffening.is_some() {
-            workspace.geometric_stiffness = Some(GeometricStiffening::pattern(&self.mesh));
+            forces.geometric_stiffness = Some(GeometricStiffening::pattern(&self.mesh));
         }
         let allowed = Features {
             nonlinear_forces: p.nonlinear_forces,
@@ -405,22 +346,18 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
-        let explicit = self.explicit_scheme(&body, lumped, &free)?;
-        let radau = self.radau_model(&body, &free)?;
+        let integrator = self.time_integrator(&body, lumped, &free)?;
         let p = &self.parameters;
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {
             key,
-            radau,
             body,
-            scheme: GeneralizedAlpha::new(p.rho_inf),
-            matrices: Vec::new(),
+            integrator,
             mass: ConsistentAcceleration::new(&free)?,
-            explicit,
             strain_monitor: monitored.then(|| (StrainMonitor::new(&self.mesh), false)),
             free,
-            workspace,
+            forces,
             stiffening,
             indicators,
             allowed,
@@ -508,113 +445,76 @@ impl Slave {
         Some(ind)
     }
 
-    /// The central-difference scheme (`solver.integrator = centralDifference`) with its stable
-    /// step logged, else `None`.
-    fn explicit_scheme(
+    /// The scheme of `solver.integrator`: generalized-α (ρ∞ = `solver.rhoInf`), Radau IIA (not
+    /// with the full formulation: its constant matrices hold the rotated small-strain
+    /// stiffness) or central difference (its stable step logged).
+    fn time_integrator(
         &mut self,
         body: &Body,
         lumped: &[f64],
         free: &FreeNodes,
-    ) -> Result<Option<CentralDifference>> {
+    ) -> Result<TimeIntegrator> {
         let p = &self.parameters;
-        if p.integrator != Integrator::CentralDifference {
-            return Ok(None);
-        }
-        let scheme = CentralDifference::new(body, lumped, free)?;
-        self.events.push(LogEvent {
-            category: category::EVENTS,
-            message: format!(
-                "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
-                scheme.highest_frequency,
-                scheme.stable_step(),
-                crate::solver::central_difference::STABILITY_MARGIN,
-                if p.step_size > scheme.stable_step() {
-                    format!(
-                        "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
-                        p.step_size
-                    )
-                } else {
-                    String::new()
-                }
-            ),
-        });
-        Ok(Some(scheme))
+        let depth = p.anderson_depth as usize;
+        Ok(match p.integrator {
+            Integrator::GeneralizedAlpha => TimeIntegrator::GeneralizedAlpha {
+                scheme: GeneralizedAlpha::new(p.rho_inf),
+                cache: FactorCache::new(),
+                workspace: StepWorkspace::with_anderson_depth(body, free, depth),
+            },
+            Integrator::RadauIIA if p.formulation == Formulation::Full => {
+                return Err(Error::new(
+                    "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+                ))
+            }
+            Integrator::RadauIIA => TimeIntegrator::RadauIIA {
+                tableau: RadauIIA::new(),
+                cache: FactorCache::new(),
+                workspace: RadauWorkspace::with_anderson_depth(body, free, depth),
+            },
+            Integrator::CentralDifference => {
+                let scheme = CentralDifference::new(body, lumped, free)?;
+                self.events.push(LogEvent {
+                    category: category::EVENTS,
+                    message: format!(
+                        "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
+                        scheme.highest_frequency,
+                        scheme.stable_step(),
+                        crate::solver::central_difference::STABILITY_MARGIN,
+                        if p.step_size > scheme.stable_step() {
+                            format!(
+                                "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
+                                p.step_size
+                            )
+                        } else {
+                            String::new()
+                        }
+                    ),
+                });
+                TimeIntegrator::CentralDifference(scheme)
+            }
+        })
     }
 
-    /// Radau IIA's part of the model (`solver.integrator = radauIIA`), else `None`. Its constant
-    /// matrices hold the rotated small-strain stiffness: no tangent for the full formulation.
-    fn radau_model(&self, body: &Body, free: &FreeNodes) -> Result<Option<RadauModel>> {
-        let p = &self.parameters;
-        if p.integrator != Integrator::RadauIIA {
-            return Ok(None);
-        }
-        if p.formulation == Formulation::Full {
-            return Err(Error::new(
-                "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
-            ));
-        }
-        Ok(Some(RadauModel {
-            tableau: RadauIIA::new(),
-            matrices: Vec::new(),
-            workspace: RadauWorkspace::with_anderson_depth(body, free, p.anderson_depth as usize),
-        }))
-    }
-
-    /// Index of the factorization for internal step `h` in the cache (factorising on a miss and
-    /// evicting the least recently used entry when [`MATRIX_CACHE_SIZE`] are kept).
-    pub(super) fn matrix_index(&mut self, h: f64) -> Result<usize> {
+    /// Builds the model if needed and makes the integrator ready for internal step `h`
+    /// (factorising on a cache miss, logged under `logEvents`).
+    pub(super) fn prepare_step_size(&mut self, h: f64) -> Result<()> {
         self.ensure_model()?;
         let p = &self.parameters;
         let model = self.model.as_mut().unwrap();
-        if model.explicit.is_some() {
-            return Ok(usize::MAX); // the explicit scheme factorises nothing
+        let damping = Damping {
+            alpha: p.damping_alpha,
+            beta: p.damping_beta,
+        };
+        if let Some(message) = model
+            .integrator
+            .prepare(h, &model.body, &model.free, damping)?
+        {
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message,
+            });
         }
-        let events = &mut self.events;
-        if let Some(radau) = &mut model.radau {
-            return cached_factorization(
-                &mut radau.matrices,
-                h,
-                |m| m.step_size,
-                || {
-                    RadauMatrix::new(
-                        &model.body,
-                        &model.free,
-                        &radau.tableau,
-                        h,
-                        p.damping_alpha,
-                        p.damping_beta,
-                    )
-                },
-                |matrix, seconds| {
-                    format!(
-                    "factorised the Radau IIA matrices for internal step h = {h:e} s: real Cholesky nnz(L) = {} and complex LU ({seconds:.3} s); they serve every step of this size",
-                    matrix.real_factor_nnz()
-                )
-                },
-                events,
-            );
-        }
-        cached_factorization(
-            &mut model.matrices,
-            h,
-            |m| m.step_size,
-            || {
-                IterationMatrix::new(
-                    &model.body,
-                    &model.free,
-                    &model.scheme,
-                    h,
-                    p.damping_alpha,
-                    p.damping_beta,
-                )
-            },
-            |matrix, seconds| {
-                format!(
-                "factorised the iteration matrix for internal step h = {h:e} s: nnz(L) = {} ({seconds:.3} s); it serves every step of this size",
-                matrix.factor.factor_nnz()
-            )
-            },
-            events,
-        )
+        Ok(())
     }
 }

@@ -7,7 +7,8 @@ use super::interfaces::{apply_loads, prescribe_motion, rotation_input};
 use super::{Dynamics, Slave};
 use crate::error::{Error, Result};
 use crate::model::InterfaceKind;
-use crate::solver::generalized_alpha::{self, DynamicState};
+use crate::solver::generalized_alpha;
+use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// The rigid placement of the body at the start: `x_i = origin + Q (X_i − anchor)`,
@@ -93,12 +94,12 @@ impl Slave {
             &model.free,
             &loads,
             &mut state,
-            &mut model.workspace,
+            &mut model.forces,
             &mut model.mass,
         )?;
-        if let Some(explicit) = &model.explicit {
+        if let Some(explicit) = model.integrator.explicit() {
             // The explicit scheme's accelerations belong to the lumped mass.
-            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.workspace);
+            explicit.accelerations(body, &model.free, &loads, &mut state, &mut model.forces);
         }
         self.dynamics = Some(Dynamics {
             state,

@@ -10,7 +10,7 @@ use crate::fem;
 use crate::mesh::Mesh;
 use crate::model::variables::InterfaceQuantity;
 use crate::model::{BodyFile, InterfaceKind};
-use crate::solver::generalized_alpha::DynamicState;
+use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// An interface at run time: its kind and node set.

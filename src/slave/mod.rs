@@ -11,7 +11,8 @@ use crate::model::model_description::{model_description, ModelInfo};
 use crate::model::variables::FIXED_TABLE_FINGERPRINT;
 use crate::model::{BodyFile, Target, Variable, VariableTable, VariableType};
 use crate::output::ResultWriter;
-use crate::solver::generalized_alpha::{DynamicState, FreeNodes, IterationMatrix};
+use crate::solver::generalized_alpha::IterationMatrix;
+use crate::solver::problem::{DynamicState, FreeNodes};
 use assembly::Model;
 use interfaces::{default_inputs, interfaces_of, Interface};
 use nalgebra::Vector3;
@@ -31,7 +32,8 @@ mod results;
 mod state_bytes;
 mod stepping;
 mod variables;
-pub use assembly::{Features, MATRIX_CACHE_SIZE};
+pub use crate::solver::integrator::MATRIX_CACHE_SIZE;
+pub use assembly::Features;
 pub use cosim::CoSimSlave;
 pub use parameters::Parameters;
 pub use state_bytes::PAYLOAD_FORMAT as STATE_PAYLOAD_FORMAT;
@@ -303,7 +305,7 @@ impl Slave {
     pub fn exit_initialization_mode(&mut self) -> Result<()> {
         self.ensure_initial_state()?;
         let h = self.parameters.step_size;
-        self.matrix_index(h)?;
+        self.prepare_step_size(h)?;
         self.results = None;
         if !self.parameters.output_directory.is_empty() {
             match ResultWriter::create(
@@ -348,11 +350,7 @@ impl Slave {
     /// The cached factorization of the iteration matrix for internal step `h`, if a step of that
     /// size has been taken (for measurements: the floor of a step is one solve with it).
     pub fn iteration_matrix(&self, h: f64) -> Option<&IterationMatrix> {
-        self.model
-            .as_ref()?
-            .matrices
-            .iter()
-            .find(|m| (m.step_size - h).abs() <= 1e-9 * h)
+        self.model.as_ref()?.integrator.iteration_matrix(h)
     }
 
     /// The assembled body once initialized.
@@ -375,10 +373,7 @@ impl Slave {
     pub fn cached_step_sizes(&self) -> Vec<f64> {
         self.model
             .as_ref()
-            .map_or_else(Vec::new, |m| match &m.radau {
-                Some(radau) => radau.matrices.iter().map(|x| x.step_size).collect(),
-                None => m.matrices.iter().map(|x| x.step_size).collect(),
-            })
+            .map_or_else(Vec::new, |m| m.integrator.cached_step_sizes())
     }
 
     /// Internal steps that did not converge and were retried with halved steps (each retry

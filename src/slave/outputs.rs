@@ -9,7 +9,7 @@ use crate::body::{Body, BodyKinematics};
 use crate::error::{Error, Result};
 use crate::model::variables::{FixedKey, InterfaceQuantity};
 use crate::model::{InterfaceKind, Target, VariableType};
-use crate::solver::generalized_alpha::{self, DynamicState, FreeNodes};
+use crate::solver::problem::{last_residual, residual, DynamicState, FreeNodes};
 use nalgebra::{Matrix3, Vector3};
 
 /// Outputs computed once per state, on the first read.
@@ -46,9 +46,8 @@ impl Slave {
         let loads = |x: &[f64], f: &mut [f64]| {
             apply_loads(body, interfaces, loads_in, None, &gravity, x, f)
         };
-        let kin =
-            generalized_alpha::residual(body, &model.free, state, &loads, &mut model.workspace);
-        let residual = generalized_alpha::last_residual(&model.workspace);
+        let kin = residual(body, &model.free, state, &loads, &mut model.forces);
+        let residual = last_residual(&model.forces);
         body_outputs(body, state, &kin, &mut self.outputs);
         for (k, interface) in self.interfaces.iter().enumerate() {
             interface_outputs(

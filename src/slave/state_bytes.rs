@@ -25,7 +25,7 @@ use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, I
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
-use crate::solver::generalized_alpha::DynamicState;
+use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
 pub const PAYLOAD_FORMAT: u32 = 3;

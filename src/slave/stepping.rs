@@ -6,8 +6,8 @@ use super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
-use crate::solver::generalized_alpha::{self, DynamicState, IterationSettings};
-use crate::solver::radau::{self, RadauProblem};
+use crate::solver::problem::{DynamicState, IterationSettings, StepProblem};
+use crate::solver::radau::RadauProblem;
 use nalgebra::Vector3;
 
 /// How often an internal step that did not converge is retried with halved internal steps
@@ -79,10 +79,11 @@ impl Slave {
             ));
         }
         // The explicit scheme's internal step is limited to its stable step.
-        let largest_step = match self.model.as_ref().and_then(|m| m.explicit.as_ref()) {
-            Some(explicit) => self.parameters.step_size.min(explicit.stable_step()),
-            None => self.parameters.step_size,
-        };
+        let step_size = self.parameters.step_size;
+        let largest_step = self
+            .model
+            .as_ref()
+            .map_or(step_size, |m| m.integrator.largest_step(step_size));
         let substeps = ((big_h / largest_step) * (1.0 - 1e-9)).ceil().max(1.0);
         if substeps > 1e9 {
             return Err(Error::invalid_value(
@@ -115,8 +116,11 @@ impl Slave {
     /// terms in force, the geometric stiffness of the current prestress and the backup.
     fn prepare_step(&mut self, t_c: f64, h: f64) -> Result<()> {
         self.update_driving_frames()?;
-        self.matrix_index(h)?;
-        let model = self.model.as_mut().expect("matrix_index built the model");
+        self.prepare_step_size(h)?;
+        let model = self
+            .model
+            .as_mut()
+            .expect("prepare_step_size built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
         choose_features(
             model,
@@ -126,7 +130,7 @@ impl Slave {
         );
         if let (Some(stiffening), Some(k_g)) = (
             model.stiffening.as_mut(),
-            model.workspace.geometric_stiffness.as_mut(),
+            model.forces.geometric_stiffness.as_mut(),
         ) {
             let s = &dynamics.state;
             stiffening.update(
@@ -176,7 +180,7 @@ impl Slave {
         let Some((monitor, above)) = &mut model.strain_monitor else {
             return;
         };
-        let g = monitor.largest_gradient(model.workspace.force_scratch().local_deformation());
+        let g = monitor.largest_gradient(model.forces.force_scratch().local_deformation());
         if g > DEFAULT_THRESHOLD && !*above {
             *above = true;
             self.events.push(LogEvent {
@@ -231,14 +235,14 @@ impl Slave {
         loop {
             let m = 1usize << depth;
             let hs = h / m as f64;
-            let index = self.matrix_index(hs)?;
+            self.prepare_step_size(hs)?;
             if depth > 0 {
                 let state = &self.dynamics.as_ref().unwrap().state;
                 self.retry_backup
                     .get_or_insert_with(|| state.clone())
                     .copy_from(state);
             }
-            let result = self.advance(index, t_c, big_h, tau0, hs, m, i + 1 == n);
+            let result = self.advance(t_c, big_h, tau0, hs, m, i + 1 == n);
             let e = match result {
                 Ok(()) => return Ok(()),
                 Err(e) => e,
@@ -272,7 +276,7 @@ impl Slave {
         }
     }
 
-    /// `m` internal steps of `hs` with iteration matrix `index`, from `tau0` after the
+    /// `m` internal steps of `hs` (prepared), from `tau0` after the
     /// communication point `t_c`. Force inputs are taken at each internal step's end,
     /// `u(t_c + τ) = u + u'·τ + u''·τ²/2` (the generalized-α scheme here satisfies the equations
     /// of motion at the end of each internal step, so this is where the load enters); the last
@@ -280,7 +284,6 @@ impl Slave {
     #[allow(clippy::too_many_arguments)]
     pub(super) fn advance(
         &mut self,
-        index: usize,
         t_c: f64,
         big_h: f64,
         tau0: f64,
@@ -316,7 +319,7 @@ impl Slave {
         let prescribe = |t: f64, state: &mut DynamicState| {
             prescribe_motion(body, interfaces, driving, t - t_c, state)
         };
-        let problem = generalized_alpha::StepProblem {
+        let problem = StepProblem {
             body,
             free: &model.free,
             loads: &loads,
@@ -339,28 +342,14 @@ impl Slave {
             } else {
                 tau0 + (j + 1) as f64 * hs
             });
-            let report = match (&model.explicit, &mut model.radau) {
-                (Some(explicit), _) => {
-                    explicit.step(&problem, hs, &mut dynamics.state, &mut model.workspace)?
-                }
-                (None, Some(radau)) => radau::step(
-                    &radau_problem,
-                    &mut radau.matrices[index],
-                    &settings,
-                    hs,
-                    &mut dynamics.state,
-                    &mut radau.workspace,
-                    &mut model.workspace,
-                )?,
-                (None, None) => generalized_alpha::step(
-                    &problem,
-                    &mut model.matrices[index],
-                    &settings,
-                    hs,
-                    &mut dynamics.state,
-                    &mut model.workspace,
-                )?,
-            };
+            let report = model.integrator.step(
+                &problem,
+                &radau_problem,
+                &settings,
+                hs,
+                &mut dynamics.state,
+                &mut model.forces,
+            )?;
             self.statistics.0 += 1;
             self.statistics.1 += report.iterations as u64;
         }

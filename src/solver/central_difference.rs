@@ -14,10 +14,11 @@
 //! Point constraints (pins, hinges) are not supported by this scheme (an error at setup); fixed
 //! supports and motion interfaces are (their nodes are prescribed).
 
-use super::generalized_alpha::{residual, FreeNodes, StepProblem, StepReport, StepWorkspace};
+use super::problem::{
+    last_residual, residual, DynamicState, FreeNodes, ResidualWorkspace, StepProblem, StepReport,
+};
 use crate::body::Body;
 use crate::error::{Error, Result};
-use crate::solver::generalized_alpha::DynamicState;
 
 /// The enforced step is at most this fraction of the estimated `h_crit`: the power iteration
 /// estimates `ω_max` from below (to about 1 % after [`POWER_ITERATIONS`]), and damping and
@@ -115,7 +116,7 @@ impl CentralDifference {
         free: &FreeNodes,
         loads: &dyn Fn(&[f64], &mut [f64]),
         state: &mut DynamicState,
-        ws: &mut StepWorkspace,
+        ws: &mut ResidualWorkspace,
     ) {
         for &i in &free.nodes {
             state.acceleration[3 * i..3 * i + 3].fill(0.0);
@@ -123,7 +124,7 @@ impl CentralDifference {
         // The residual at zero free acceleration is f(x, v) − f_ext (+ the clamped nodes'
         // inertia coupling).
         residual(body, free, state, loads, ws);
-        let r = super::generalized_alpha::last_residual(ws);
+        let r = last_residual(ws);
         for &i in &free.nodes {
             let w = self.inverse_mass[i];
             let nodal = &r[3 * i..3 * i + 3];
@@ -144,7 +145,7 @@ impl CentralDifference {
         problem: &StepProblem,
         h: f64,
         state: &mut DynamicState,
-        ws: &mut StepWorkspace,
+        ws: &mut ResidualWorkspace,
     ) -> Result<StepReport> {
         if h > self.stable_step() * (1.0 + 1e-12) {
             return Err(Error::discard(format!(
@@ -169,7 +170,7 @@ impl CentralDifference {
             state.acceleration[3 * i..3 * i + 3].fill(0.0);
         }
         residual(problem.body, free, state, problem.loads, ws);
-        let r = super::generalized_alpha::last_residual(ws);
+        let r = last_residual(ws);
         let mut finite = true;
         for &i in &free.nodes {
             let w = self.inverse_mass[i];

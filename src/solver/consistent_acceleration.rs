@@ -9,9 +9,9 @@
 //! solve pairs and `O(m N_F)`; no allocation.
 //!
 //! It serves the initial acceleration and the restart of the scheme when the held inputs jump
-//! at a communication point ([`super::generalized_alpha::restart_for_load_change`]).
+//! at a communication point (generalized-α's `restart_for_load_change`).
 
-use super::generalized_alpha::FreeNodes;
+use super::problem::FreeNodes;
 use crate::error::{Error, Result};
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use nalgebra::DMatrix;

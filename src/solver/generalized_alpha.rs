@@ -18,15 +18,21 @@
 //! one forward and one backward triangular solve with the constant factor of `S̄` and rotates back.
 //! With `ρ∞ = 1` the scheme is the trapezoidal rule (energy-conserving on linear problems).
 
-use super::anderson::Anderson;
+use super::anderson::{Anderson, DEFAULT_DEPTH};
 use super::consistent_acceleration::ConsistentAcceleration;
-use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
+use super::constraints::ConstraintFactor;
+use super::fixed_point::{largest_correction, mix_update, Convergence};
+use super::problem::{
+    residual, DynamicState, FreeNodes, IterationSettings, ResidualWorkspace, StepProblem,
+    StepReport,
+};
 use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
-use crate::body::{Body, BodyKinematics, ForceScratch};
+use crate::body::{Body, BodyKinematics};
 use crate::error::{Error, Result};
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use crate::linalg::SymmetricCsr;
+use nalgebra::Matrix3;
 
 /// Generalized-α coefficients from the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`:
 /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`, `β = ¼ (1 − α_m + α_f)²`
@@ -59,85 +65,6 @@ impl GeneralizedAlpha {
     /// `c_d = γ / (β h)` (1/s): `∂ẋ_{n+1}/∂x_{n+1}`.
     pub fn damping_coefficient(&self, h: f64) -> f64 {
         self.gamma / (self.beta * h)
-    }
-}
-
-/// Which nodes move: the others are clamped (a `fixed` support) and keep their positions.
-#[derive(Debug, Clone)]
-pub struct FreeNodes {
-    /// Free node indices, ascending; free node `k` owns rows `3k..3k+3` of the reduced system.
-    pub nodes: Vec<usize>,
-    /// The clamped (prescribed) nodes, ascending.
-    pub clamped: Vec<usize>,
-    /// `M ⊗ I3` restricted to the free DOFs.
-    pub mass: SymmetricCsr,
-    /// `K` restricted to the free DOFs.
-    pub stiffness: SymmetricCsr,
-    /// `Ms` restricted to the free nodes (scalar).
-    pub scalar_mass: SymmetricCsr,
-    /// Point constraints (pins) on free nodes, solved with Lagrange multipliers.
-    pub constraints: Vec<PointConstraint>,
-}
-
-impl FreeNodes {
-    /// Free nodes of `body` when `clamped` nodes are held.
-    pub fn new(body: &Body, clamped: &[bool]) -> FreeNodes {
-        let nodes: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
-        let dofs: Vec<usize> = nodes
-            .iter()
-            .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
-        let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
-        let stiffness = body.stiffness_matrix.submatrix(&dofs);
-        let scalar_mass = body.mass_matrix.submatrix(&nodes);
-        FreeNodes {
-            nodes,
-            clamped: (0..body.node_count()).filter(|&i| clamped[i]).collect(),
-            mass,
-            stiffness,
-            scalar_mass,
-            constraints: Vec::new(),
-        }
-    }
-
-    /// Adds a point constraint holding the weighted centroid of `nodes` (weights `weights`, any
-    /// positive scale) at `target` (m). Error if a node is clamped.
-    pub fn add_point_constraint(
-        &mut self,
-        name: &str,
-        nodes: &[usize],
-        weights: &[f64],
-        target: nalgebra::Vector3<f64>,
-    ) -> Result<()> {
-        let total: f64 = weights.iter().sum();
-        let mut free_rows = Vec::with_capacity(nodes.len());
-        for &n in nodes {
-            match self.nodes.binary_search(&n) {
-                Ok(k) => free_rows.push(3 * k),
-                Err(_) => {
-                    return Err(Error::new(format!(
-                        "interface '{name}': node {n} is also held by a fixed support or motion interface"
-                    )))
-                }
-            }
-        }
-        self.constraints.push(PointConstraint {
-            nodes: nodes.to_vec(),
-            weights: weights.iter().map(|w| w / total).collect(),
-            free_rows,
-            target,
-        });
-        Ok(())
-    }
-
-    /// Number of Lagrange multipliers (3 per point constraint).
-    pub fn multiplier_count(&self) -> usize {
-        3 * self.constraints.len()
-    }
-
-    /// Number of free DOFs.
-    pub fn dof_count(&self) -> usize {
-        3 * self.nodes.len()
     }
 }
 
@@ -181,11 +108,7 @@ impl TangentMatrix {
     ) -> TangentMatrix {
         let full = body.full.as_ref().expect("the full formulation");
         let tangent = full.tangent_pattern();
-        let dofs: Vec<usize> = free
-            .nodes
-            .iter()
-            .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect();
+        let dofs = free.dofs();
         let find = |m: &SymmetricCsr, row: usize, col: usize| {
             let range = m.row_ptr[row]..m.row_ptr[row + 1];
             m.col_idx[range.clone()]
@@ -315,184 +238,46 @@ impl IterationMatrix {
     }
 }
 
-/// Positions, velocities, accelerations and pseudo-accelerations (flat `3N`) at `time`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DynamicState {
-    pub time: f64,
-    pub position: Vec<f64>,
-    pub velocity: Vec<f64>,
-    pub acceleration: Vec<f64>,
-    pub pseudo_acceleration: Vec<f64>,
-    /// Lagrange multipliers of the point constraints (N, global; 3 per constraint): the
-    /// constraint load on the body is `−Cᵀλ`.
-    pub multipliers: Vec<f64>,
-}
-
-impl DynamicState {
-    /// Copies `other` into `self` without allocating.
-    pub fn copy_from(&mut self, other: &DynamicState) {
-        self.time = other.time;
-        self.position.copy_from_slice(&other.position);
-        self.velocity.copy_from_slice(&other.velocity);
-        self.acceleration.copy_from_slice(&other.acceleration);
-        self.pseudo_acceleration
-            .copy_from_slice(&other.pseudo_acceleration);
-        self.multipliers.copy_from_slice(&other.multipliers);
-    }
-}
-
-/// What a step did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepReport {
-    pub iterations: usize,
-    /// Largest position correction of the last iteration (m).
-    pub last_correction: f64,
-}
-
-/// Settings of the fixed-point iteration.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IterationSettings {
-    /// Converged when the estimated position error of the iterate is below this (m): the
-    /// largest correction, or after the second iteration [`remaining_error`] of it.
-    pub absolute_tolerance: f64,
-    pub max_iterations: usize,
-}
-
-/// The largest contraction `θ = ‖Δ_k‖/‖Δ_{k−1}‖` of successive corrections for which the
-/// error estimate [`remaining_error`] is trusted (Hairer & Wanner, *Solving ODEs II*, IV.8: the
-/// simplified Newton iteration of implicit Runge–Kutta methods stops on this estimate). Above it
-/// the iteration runs until the correction itself is below the tolerance.
-pub const TRUSTED_CONTRACTION: f64 = 0.5;
-
-/// The position error left after applying correction `Δ_k` of a linearly converging iteration
-/// with contraction `θ = ‖Δ_k‖/‖Δ_{k−1}‖`: the corrections still to come sum to at most
-/// `θ/(1−θ) ‖Δ_k‖` (infinity when `θ` exceeds [`TRUSTED_CONTRACTION`] or is unknown). With the
-/// constant iteration matrix `θ` is small (the rotation of the frame over a step: 1e-4 to 1e-6 on
-/// B1), so this accepts after two iterations a step that the correction alone accepts after
-/// three, with an estimated error far below the tolerance.
-pub fn remaining_error(correction: f64, previous_correction: f64) -> f64 {
-    let theta = correction / previous_correction;
-    if previous_correction.is_finite() && theta.is_finite() && theta <= TRUSTED_CONTRACTION {
-        theta / (1.0 - theta) * correction
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// Default history depth of Anderson's acceleration ([`super::anderson`]) of the fixed-point
-/// iteration: 5 columns cost 10 vectors of the free DOFs and `O(5 n)` per iteration; on B3 with
-/// patches deeper histories gave no fewer iterations (`examples/iteration_policy.rs`).
-pub const DEFAULT_ANDERSON_DEPTH: usize = 5;
-
-/// Work vectors of a step (allocated once: a step allocates nothing).
+/// Generalized-α's work vectors of a step besides the residual's (allocated once: a step
+/// allocates nothing).
 pub struct StepWorkspace {
-    internal: Vec<f64>,
-    external: Vec<f64>,
-    inertia: Vec<f64>,
+    /// The free part of the residual in the co-moving frame, then the solution of `S̄ y = r̄`.
     reduced: Vec<f64>,
-    force_scratch: ForceScratch,
+    /// The state at the start of the step.
     previous: DynamicState,
     /// Anderson's acceleration: its history, the iterate `z = [x_F, λ]` and its update.
     anderson: Anderson,
     iterate: Vec<f64>,
     update: Vec<f64>,
+    /// `Δλ` of [`restart_for_load_change`].
     multiplier_change: Vec<f64>,
-    /// The geometric stiffness `K_G` of the current prestress (stiffening), if any: set by the
-    /// owner before a step, constant during it.
-    pub geometric_stiffness: Option<SymmetricCsr>,
 }
 
 impl StepWorkspace {
-    /// The body's force scratch: `ū`, `g` of the last residual.
-    pub fn force_scratch(&self) -> &ForceScratch {
-        &self.force_scratch
-    }
-
-    /// The geometric stiffness (if any) and the force scratch, for another scheme's residual
-    /// ([`super::radau`]) that shares this workspace's stiffening and strain watch.
-    pub fn force_parts(&mut self) -> (Option<&SymmetricCsr>, &mut ForceScratch) {
-        (self.geometric_stiffness.as_ref(), &mut self.force_scratch)
-    }
-
+    /// Workspace with Anderson's acceleration of the default depth ([`DEFAULT_DEPTH`]).
     pub fn new(body: &Body, free: &FreeNodes) -> StepWorkspace {
-        Self::with_anderson_depth(body, free, DEFAULT_ANDERSON_DEPTH)
+        Self::with_anderson_depth(body, free, DEFAULT_DEPTH)
     }
 
     /// Workspace with Anderson's acceleration of history `depth` (0: the plain iteration).
     pub fn with_anderson_depth(body: &Body, free: &FreeNodes, depth: usize) -> StepWorkspace {
-        let n3 = body.reference.len();
         let nz = free.dof_count() + free.multiplier_count();
         StepWorkspace {
             anderson: Anderson::new(depth, nz, free.dof_count()),
             iterate: vec![0.0; nz],
             update: vec![0.0; nz],
             multiplier_change: vec![0.0; free.multiplier_count()],
-            internal: vec![0.0; n3],
-            external: vec![0.0; n3],
-            inertia: vec![0.0; n3],
             reduced: vec![0.0; free.dof_count()],
-            force_scratch: body.force_scratch(),
-            previous: DynamicState {
-                time: 0.0,
-                position: vec![0.0; n3],
-                velocity: vec![0.0; n3],
-                acceleration: vec![0.0; n3],
-                pseudo_acceleration: vec![0.0; n3],
-                multipliers: vec![0.0; free.multiplier_count()],
-            },
-            geometric_stiffness: None,
+            previous: DynamicState::zeros(body.reference.len(), free.multiplier_count()),
         }
     }
 }
 
-/// The residual `r = M ẍ + f(x, ẋ) + Cᵀλ − f_ext(x)` (full `3N`, in `ws.internal`), and the
-/// body's kinematics on the way. `loads(x, f_ext)` adds the external loads to a zeroed `f_ext`.
-pub fn residual(
-    body: &Body,
-    free: &FreeNodes,
-    state: &DynamicState,
-    loads: &dyn Fn(&[f64], &mut [f64]),
-    ws: &mut StepWorkspace,
-) -> BodyKinematics {
-    let kin = body.internal_force(
-        &state.position,
-        &state.velocity,
-        ws.geometric_stiffness.as_ref(),
-        &mut ws.force_scratch,
-        &mut ws.internal,
-    );
-    ws.external.fill(0.0);
-    loads(&state.position, &mut ws.external);
-    body.mass_times(&state.acceleration, &mut ws.inertia);
-    for k in 0..ws.internal.len() {
-        ws.internal[k] += ws.inertia[k] - ws.external[k];
-    }
-    add_constraint_forces(&free.constraints, &state.multipliers, &mut ws.internal);
-    kin
-}
-
-/// The residual left in `ws` by the last [`residual`] call.
-pub fn last_residual(ws: &StepWorkspace) -> &[f64] {
-    &ws.internal
-}
-
-/// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.
-pub type Prescription<'a> = &'a dyn Fn(f64, &mut DynamicState);
-
-/// What a step of any scheme needs besides the state: the body, its free nodes and constraints,
-/// the external loads (`loads(x, f_ext)` adds them to a zeroed `f_ext`) and the prescription of
-/// the clamped nodes. (Generalized-α's own scheme lives in its [`IterationMatrix`], its iteration
-/// settings are an argument of [`step`].)
-pub struct StepProblem<'a> {
-    pub body: &'a Body,
-    pub free: &'a FreeNodes,
-    pub loads: &'a dyn Fn(&[f64], &mut [f64]),
-    pub prescribe: Prescription<'a>,
-}
-
 /// One step `t → t + h` of `state`. The clamped nodes are set by `prescribe(t + h, state)`; the
-/// free ones follow from the iteration. On failure (no convergence, non-finite values) `state` is
-/// left as it was and the error is an [`crate::ErrorKind::Discard`].
+/// free ones follow from the iteration. `forces` holds the residual's vectors and the geometric
+/// stiffness of stiffening, if set; after the step its force scratch holds `ū`, `g` of the last
+/// iterate. On failure (no convergence, non-finite values) `state` is left as it was and the
+/// error is an [`crate::ErrorKind::Discard`].
 pub fn step(
     problem: &StepProblem,
     matrix: &mut IterationMatrix,
@@ -500,15 +285,19 @@ pub fn step(
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
 ) -> Result<StepReport> {
     ws.previous.copy_from(state);
-    let result = iterate(problem, matrix, settings, h, state, ws);
+    let result = iterate(problem, matrix, settings, h, state, ws, forces);
     if result.is_err() {
         state.copy_from(&ws.previous);
     }
     result
 }
 
+/// The fixed-point iteration of a step from the predictor: per iteration the residual, the
+/// plain correction `g = −P⁻¹ r` ([`IterationMatrix::plain_update`]), the stopping test
+/// ([`Convergence`]), Anderson's mixing and the update of `x`, `ẋ`, `ẍ` and `λ`.
 fn iterate(
     problem: &StepProblem,
     matrix: &mut IterationMatrix,
@@ -516,25 +305,55 @@ fn iterate(
     h: f64,
     state: &mut DynamicState,
     ws: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
 ) -> Result<StepReport> {
     let StepProblem {
-        body,
-        free,
-        loads,
-        prescribe,
+        body, free, loads, ..
     } = *problem;
     let scheme = matrix.scheme;
+    predict(&scheme, problem, h, &ws.previous, state);
+    let mut convergence = Convergence::new("", settings, state.time, h);
+    ws.anderson.reset();
+    for iteration in 1..=settings.max_iterations {
+        let kin = residual(body, free, state, loads, forces);
+        if iteration == 1 {
+            matrix.freeze_nonlinear_jacobian(body, free, &kin, &state.position, forces);
+        }
+        let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
+        let largest = matrix.plain_update(body, free, &frame, state, ws, forces);
+        let converged = convergence.converged(largest)?;
+        if matrix.newton.is_none() {
+            mix_update(&mut ws.anderson, converged, &ws.iterate, &mut ws.update);
+        }
+        apply_update(&scheme, h, free, state, ws);
+        if converged {
+            update_pseudo_acceleration(&scheme, free, &ws.previous, state);
+            return Ok(StepReport {
+                iterations: iteration,
+                last_correction: convergence.last_correction(),
+            });
+        }
+    }
+    Err(convergence.failure())
+}
+
+/// The predictor at `t_{n+1} = t_n + h` from the step's start `prev`: for the free nodes
+/// `ẍ_{n+1} = ẍ_n`, then `a_{n+1}`, `x_{n+1}`, `ẋ_{n+1}` from the update formulas; the clamped
+/// nodes' positions are prescribed at `t_{n+1}` ([`follow_prescribed_positions`]).
+fn predict(
+    scheme: &GeneralizedAlpha,
+    problem: &StepProblem,
+    h: f64,
+    prev: &DynamicState,
+    state: &mut DynamicState,
+) {
     let GeneralizedAlpha {
         alpha_m,
         alpha_f,
         beta,
         gamma,
-    } = scheme;
-    let c_m = scheme.mass_coefficient(h);
-    let c_d = scheme.damping_coefficient(h);
-    let prev = &ws.previous;
-    // Predictor ẍ_{n+1} = ẍ_n, then a, x, ẋ from the update formulas (free nodes only).
-    for &i in &free.nodes {
+    } = *scheme;
+    for &i in &problem.free.nodes {
         for d in 3 * i..3 * i + 3 {
             let acc = prev.acceleration[d];
             let a_new = (alpha_f * prev.acceleration[d] - alpha_m * prev.pseudo_acceleration[d]
@@ -549,11 +368,28 @@ fn iterate(
         }
     }
     state.time = prev.time + h;
-    // Clamped nodes: positions prescribed at t_{n+1}; their velocities and accelerations follow
-    // from the same update formulas as the free nodes', so that the scheme sees one consistent
-    // motion (a jump of the driving velocity at a communication point becomes a finite
-    // acceleration over the step, whose inertia the reaction then carries).
-    prescribe(state.time, state);
+    (problem.prescribe)(state.time, state);
+    follow_prescribed_positions(scheme, problem.free, h, prev, state);
+}
+
+/// The clamped nodes' velocities, accelerations and pseudo-accelerations at `t_{n+1}` from
+/// their prescribed positions, by the same update formulas as the free nodes' (solved for
+/// `a_{n+1}` from `x_{n+1}`), so that the scheme sees one consistent motion: a jump of the
+/// driving velocity at a communication point becomes a finite acceleration over the step, whose
+/// inertia the reaction then carries.
+fn follow_prescribed_positions(
+    scheme: &GeneralizedAlpha,
+    free: &FreeNodes,
+    h: f64,
+    prev: &DynamicState,
+    state: &mut DynamicState,
+) {
+    let GeneralizedAlpha {
+        alpha_m,
+        alpha_f,
+        beta,
+        gamma,
+    } = *scheme;
     for &i in &free.clamped {
         for d in 3 * i..3 * i + 3 {
             let a_old = prev.pseudo_acceleration[d];
@@ -569,158 +405,180 @@ fn iterate(
             state.pseudo_acceleration[d] = a_new;
         }
     }
+}
 
-    let mut last_correction = f64::INFINITY;
-    ws.anderson.reset();
-    for iteration in 1..=settings.max_iterations {
-        let kin = residual(body, free, state, loads, ws);
-        // The correction only while f_nl is on (`model.auto` switches it between steps).
-        let nonlinear = matrix
-            .nonlinear
+impl IterationMatrix {
+    /// The Woodbury correction of `f_nl`, while `f_nl` is on (`model.auto` switches it between
+    /// steps).
+    fn active_nonlinear(&mut self, body: &Body) -> Option<&mut NonlinearForceCorrection> {
+        self.nonlinear
             .as_mut()
-            .filter(|_| body.options.nonlinear_forces);
-        if let (1, Some(correction)) = (iteration, nonlinear) {
-            // The f_nl Jacobian, frozen over the step at the predictor.
+            .filter(|_| body.options.nonlinear_forces)
+    }
+
+    /// Freezes the `f_nl` Jacobian of the Woodbury correction over the step at the predictor
+    /// (the first residual's `ū`, `g` and `H⁻¹`, `H` the frame's rotation sensitivity).
+    fn freeze_nonlinear_jacobian(
+        &mut self,
+        body: &Body,
+        free: &FreeNodes,
+        kin: &BodyKinematics,
+        position: &[f64],
+        forces: &ResidualWorkspace,
+    ) {
+        if let Some(correction) = self.active_nonlinear(body) {
             let h_inv = body
                 .frame_weights
-                .rotation_sensitivity(&kin.frame, &state.position)
+                .rotation_sensitivity(&kin.frame, position)
                 .try_inverse()
-                .unwrap_or_else(nalgebra::Matrix3::zeros);
+                .unwrap_or_else(Matrix3::zeros);
             correction.update(
                 body,
                 free,
-                ws.force_scratch.local_deformation(),
-                ws.force_scratch.elastic_force(),
+                forces.force_scratch.local_deformation(),
+                forces.force_scratch.elastic_force(),
                 &h_inv,
             );
         }
-        // Reduced strain: the constant matrix in the co-moving frame. Full: Newton on the
-        // tangent at the current positions, in the global frame.
-        let r = if let Some(newton) = &mut matrix.newton {
-            newton.refactor(body, free, &state.position, &mut matrix.factor)?;
-            if matrix.constraint.is_some() {
-                matrix.constraint = Some(ConstraintFactor::new(
-                    &free.constraints,
-                    &matrix.factor,
-                    &mut matrix.workspace,
-                )?);
-            }
-            nalgebra::Matrix3::identity()
-        } else {
-            kin.frame.rotation
+    }
+
+    /// The rotation `R` of this iteration's matrix `hR S̄ hRᵀ`: reduced strain, the constant
+    /// matrix in the co-moving frame (`R` the frame's rotation); full formulation, Newton on the
+    /// tangent at the current positions `x` in the global frame (`R = I`, the factor and the
+    /// constraints' Schur complement refactorised).
+    fn iteration_frame(
+        &mut self,
+        body: &Body,
+        free: &FreeNodes,
+        kin: &BodyKinematics,
+        x: &[f64],
+    ) -> Result<Matrix3<f64>> {
+        let Some(newton) = &mut self.newton else {
+            return Ok(kin.frame.rotation);
         };
-        // Each node's rotation: the body frame's, or with patches (and no point constraints,
-        // whose Schur complement is built in the body frame) the frame of the node's patch, so
-        // that the iteration matrix follows each part of a strongly bent body.
+        newton.refactor(body, free, x, &mut self.factor)?;
+        if self.constraint.is_some() {
+            self.constraint = Some(ConstraintFactor::new(
+                &free.constraints,
+                &self.factor,
+                &mut self.workspace,
+            )?);
+        }
+        Ok(Matrix3::identity())
+    }
+
+    /// The plain update `g = [Δx_F, Δλ]` of the iterate `z = [x_F, λ]` (both into `ws`): the free
+    /// residual rotated into each node's frame, one solve with the constant factor (with the
+    /// Woodbury correction of `f_nl` and the constraints' Schur complement, which sets the new
+    /// `λ` in `state`), rotated back. Each node's rotation is the frame's `frame`, or with patches
+    /// (and no point constraints, whose Schur complement is built in the body frame, nor Newton)
+    /// the frame of the node's patch, so that the matrix follows each part of a strongly bent
+    /// body. Returns the largest position correction ([`largest_correction`]).
+    fn plain_update(
+        &mut self,
+        body: &Body,
+        free: &FreeNodes,
+        frame: &Matrix3<f64>,
+        state: &mut DynamicState,
+        ws: &mut StepWorkspace,
+        forces: &ResidualWorkspace,
+    ) -> f64 {
         let patches = body
             .patches
             .as_ref()
-            .filter(|_| matrix.constraint.is_none() && matrix.newton.is_none());
-        let scratch = &ws.force_scratch;
+            .filter(|_| self.constraint.is_none() && self.newton.is_none());
+        let scratch = &forces.force_scratch;
         let rotation = |i: usize| match patches {
             Some(p) => scratch.patch_rotation(p.node_patch[i]),
-            None => r,
+            None => *frame,
         };
-        // The iterate z = [x_F, λ] before this correction (Anderson's acceleration).
-        let nf3 = free.dof_count();
+        gather_iterate(free, state, &mut ws.iterate);
         for (k, &i) in free.nodes.iter().enumerate() {
-            ws.iterate[3 * k..3 * k + 3].copy_from_slice(&state.position[3 * i..3 * i + 3]);
+            let r = rotation(i).transpose() * node(&forces.internal, i);
+            set_node(&mut ws.reduced, k, &r);
         }
-        ws.iterate[nf3..].copy_from_slice(&state.multipliers);
-        // Rotate the free part of the residual into the co-moving frame, solve, rotate back.
-        for (k, &i) in free.nodes.iter().enumerate() {
-            set_node(
-                &mut ws.reduced,
-                k,
-                &(rotation(i).transpose() * node(&ws.internal, i)),
-            );
-        }
-        matrix
-            .factor
-            .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
-        if let Some(correction) = matrix
-            .nonlinear
-            .as_ref()
-            .filter(|_| body.options.nonlinear_forces)
-        {
+        self.factor
+            .solve_in_place(&mut ws.reduced, &mut self.workspace);
+        if let Some(correction) = self.active_nonlinear(body) {
             correction.correct(&mut ws.reduced);
         }
-        if let Some(constraint) = &mut matrix.constraint {
-            constraint.correct(
-                &free.constraints,
-                &state.position,
-                &r,
-                &mut ws.reduced,
-                &mut state.multipliers,
-            );
+        if let Some(constraint) = &mut self.constraint {
+            let (x, lambda) = (&state.position, &mut state.multipliers);
+            constraint.correct(&free.constraints, x, frame, &mut ws.reduced, lambda);
         }
-        // The plain update g = [Δx_F, Δλ]; Anderson's method mixes it with the history.
         let mut largest: f64 = 0.0;
         for (k, &i) in free.nodes.iter().enumerate() {
             let dx = -(rotation(i) * node(&ws.reduced, k));
             set_node(&mut ws.update, k, &dx);
-            // A non-finite correction never counts as converged (f64::max would drop a NaN).
-            largest = if dx.iter().all(|v| v.is_finite()) {
-                largest.max(dx.amax())
-            } else {
-                f64::INFINITY
-            };
+            largest = largest_correction(largest, dx.as_slice());
         }
+        let nf3 = free.dof_count();
         for (u, (&new, &old)) in ws.update[nf3..]
             .iter_mut()
             .zip(state.multipliers.iter().zip(&ws.iterate[nf3..]))
         {
             *u = new - old;
         }
-        // Decided on the plain correction, which is then the one applied: Anderson's mixed
-        // update is not what the estimate describes.
-        let converged = largest <= settings.absolute_tolerance
-            || remaining_error(largest, last_correction) <= settings.absolute_tolerance;
-        if largest.is_finite() && !converged && matrix.newton.is_none() {
-            ws.anderson.accelerate(&ws.iterate, &mut ws.update);
-        }
-        for (k, &i) in free.nodes.iter().enumerate() {
-            for d in 0..3 {
-                let (j, dx) = (3 * i + d, ws.update[3 * k + d]);
-                state.position[j] += dx;
-                state.velocity[j] += c_d * dx;
-                state.acceleration[j] += c_m * dx;
-            }
-        }
-        for (l, (&z, &u)) in state
-            .multipliers
-            .iter_mut()
-            .zip(ws.iterate[nf3..].iter().zip(&ws.update[nf3..]))
-        {
-            *l = z + u;
-        }
-        if !largest.is_finite() {
-            return Err(Error::discard(format!(
-                "step to t = {} (h = {h}): the iteration produced a non-finite correction",
-                state.time
-            )));
-        }
-        last_correction = largest;
-        if converged {
-            let prev = &ws.previous;
-            for &i in &free.nodes {
-                for d in 3 * i..3 * i + 3 {
-                    state.pseudo_acceleration[d] = (alpha_f * prev.acceleration[d]
-                        - alpha_m * prev.pseudo_acceleration[d]
-                        + (1.0 - alpha_f) * state.acceleration[d])
-                        / (1.0 - alpha_m);
-                }
-            }
-            return Ok(StepReport {
-                iterations: iteration,
-                last_correction,
-            });
+        largest
+    }
+}
+
+/// The iterate `z = [x_F, λ]` of Anderson's acceleration: the free positions and the multipliers.
+fn gather_iterate(free: &FreeNodes, state: &DynamicState, z: &mut [f64]) {
+    for (k, &i) in free.nodes.iter().enumerate() {
+        z[3 * k..3 * k + 3].copy_from_slice(&state.position[3 * i..3 * i + 3]);
+    }
+    z[free.dof_count()..].copy_from_slice(&state.multipliers);
+}
+
+/// Applies the update `[Δx_F, Δλ]` of `ws`: `x += Δx`, `ẋ += c_d Δx`, `ẍ += c_m Δx` on the free
+/// DOFs, `λ = λ_z + Δλ` from the iterate's `λ_z`.
+fn apply_update(
+    scheme: &GeneralizedAlpha,
+    h: f64,
+    free: &FreeNodes,
+    state: &mut DynamicState,
+    ws: &StepWorkspace,
+) {
+    let c_m = scheme.mass_coefficient(h);
+    let c_d = scheme.damping_coefficient(h);
+    for (k, &i) in free.nodes.iter().enumerate() {
+        for d in 0..3 {
+            let (j, dx) = (3 * i + d, ws.update[3 * k + d]);
+            state.position[j] += dx;
+            state.velocity[j] += c_d * dx;
+            state.acceleration[j] += c_m * dx;
         }
     }
-    Err(Error::discard(format!(
-        "step to t = {} (h = {h}) did not converge in {} iterations (last position correction {last_correction:.3e} m, tolerance {:.3e} m)",
-        state.time, settings.max_iterations, settings.absolute_tolerance
-    )))
+    let nf3 = free.dof_count();
+    for (l, (&z, &u)) in state
+        .multipliers
+        .iter_mut()
+        .zip(ws.iterate[nf3..].iter().zip(&ws.update[nf3..]))
+    {
+        *l = z + u;
+    }
+}
+
+/// The converged step's pseudo-accelerations of the free nodes:
+/// `a_{n+1} = (α_f ẍ_n − α_m a_n + (1 − α_f) ẍ_{n+1}) / (1 − α_m)`.
+fn update_pseudo_acceleration(
+    scheme: &GeneralizedAlpha,
+    free: &FreeNodes,
+    prev: &DynamicState,
+    state: &mut DynamicState,
+) {
+    let GeneralizedAlpha {
+        alpha_m, alpha_f, ..
+    } = *scheme;
+    for &i in &free.nodes {
+        for d in 3 * i..3 * i + 3 {
+            state.pseudo_acceleration[d] = (alpha_f * prev.acceleration[d]
+                - alpha_m * prev.pseudo_acceleration[d]
+                + (1.0 - alpha_f) * state.acceleration[d])
+                / (1.0 - alpha_m);
+        }
+    }
 }
 
 /// Consistent initial acceleration on the free DOFs and multipliers:
@@ -731,18 +589,18 @@ pub fn initial_acceleration(
     free: &FreeNodes,
     loads: &dyn Fn(&[f64], &mut [f64]),
     state: &mut DynamicState,
-    ws: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
     mass: &mut ConsistentAcceleration,
 ) -> Result<()> {
     for &i in &free.nodes {
         state.acceleration[3 * i..3 * i + 3].fill(0.0);
     }
     state.multipliers.fill(0.0);
-    residual(body, free, state, loads, ws);
-    ws.internal.iter_mut().for_each(|r| *r = -*r);
+    residual(body, free, state, loads, forces);
+    forces.internal.iter_mut().for_each(|r| *r = -*r);
     mass.solve(
         free,
-        &ws.internal,
+        &forces.internal,
         &mut state.acceleration,
         &mut state.multipliers,
     );
@@ -759,7 +617,8 @@ pub fn initial_acceleration(
 /// loads' acceleration (the left limit) and a jump costs an error of order `h`, which made the
 /// scheme first order under inputs that change (`tests/convergence_order.rs`). For a linear
 /// system this is exact superposition: the jump's response is a fresh start from rest with
-/// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation.
+/// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation (`forces`
+/// and `ws` serve as scratch).
 ///
 /// The slave does not call it: restarting at every jump of held inputs destabilised the
 /// iterated coupling of two FMUs (see `Slave::do_step`); it is kept for importers' schemes that
@@ -770,56 +629,30 @@ pub fn restart_for_load_change(
     old_loads: &dyn Fn(&[f64], &mut [f64]),
     new_loads: &dyn Fn(&[f64], &mut [f64]),
     state: &mut DynamicState,
+    forces: &mut ResidualWorkspace,
     ws: &mut StepWorkspace,
 ) {
-    ws.external.fill(0.0);
-    new_loads(&state.position, &mut ws.external);
-    ws.inertia.fill(0.0);
-    old_loads(&state.position, &mut ws.inertia);
-    for (new, old) in ws.external.iter_mut().zip(&ws.inertia) {
+    forces.external.fill(0.0);
+    new_loads(&state.position, &mut forces.external);
+    forces.inertia.fill(0.0);
+    old_loads(&state.position, &mut forces.inertia);
+    for (new, old) in forces.external.iter_mut().zip(&forces.inertia) {
         *new -= old;
     }
-    ws.inertia.fill(0.0);
+    forces.inertia.fill(0.0);
     mass.solve(
         free,
-        &ws.external,
-        &mut ws.inertia,
+        &forces.external,
+        &mut forces.inertia,
         &mut ws.multiplier_change,
     );
     for &i in &free.nodes {
         for d in 3 * i..3 * i + 3 {
-            state.acceleration[d] += ws.inertia[d];
-            state.pseudo_acceleration[d] += ws.inertia[d];
+            state.acceleration[d] += forces.inertia[d];
+            state.pseudo_acceleration[d] += forces.inertia[d];
         }
     }
     for (l, dl) in state.multipliers.iter_mut().zip(&ws.multiplier_change) {
         *l += dl;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn remaining_error_of_a_contraction() {
-        // x_{k+1} = θ x_k: after a correction Δ the corrections still to come sum to
-        // θ/(1−θ) Δ exactly.
-        let theta: f64 = 0.1;
-        let corrections: Vec<f64> = (0..6).map(|k| theta.powi(k)).collect();
-        for k in 1..5 {
-            let still_to_come: f64 =
-                corrections[k + 1..].iter().sum::<f64>() + theta.powi(6) / (1.0 - theta); // the tail beyond the sample
-            let estimate = remaining_error(corrections[k], corrections[k - 1]);
-            assert!(
-                (estimate - still_to_come).abs() <= 1e-12 * still_to_come,
-                "{estimate} {still_to_come}"
-            );
-        }
-        // No estimate from the first correction, a slow or a diverging iteration.
-        assert_eq!(remaining_error(1e-3, f64::INFINITY), f64::INFINITY);
-        assert_eq!(remaining_error(0.6, 1.0), f64::INFINITY);
-        assert_eq!(remaining_error(2.0, 1.0), f64::INFINITY);
-        assert_eq!(remaining_error(f64::NAN, 1.0), f64::INFINITY);
     }
 }

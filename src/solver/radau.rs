@@ -32,7 +32,9 @@
 //! are `damping.alpha`, `damping.beta`. Both are factorised once per step size and reused for
 //! the whole run. An iteration: three internal-force evaluations, rotate each residual into its
 //! stage's frame, transform with `T⁻¹`, one real and one complex solve, transform back with `T`,
-//! rotate back; converged when the largest position correction is below the tolerance. Where the
+//! rotate back; converged when the largest position correction is below the tolerance
+//! ([`super::fixed_point::Convergence::correction_only`]: the `θ/(1−θ) Δ` estimate that stops
+//! generalized-α is not trusted here). Where the
 //! constant matrix misses part of the Jacobian (large bending relative to the one frame, `f_nl`,
 //! stiffening, patches), Anderson's acceleration ([`super::anderson`], `solver.andersonDepth`)
 //! mixes the corrections of all three stages, as for generalized-α.
@@ -47,11 +49,12 @@
 //! iteration tolerance (index 3, no drift). Not supported (an error at setup): the full
 //! formulation (its tangent is not the rotated constant `K`).
 
-use super::anderson::Anderson;
-use super::constraints::{add_constraint_forces, ConstraintFactor, PointConstraint};
-use super::generalized_alpha::{
-    DynamicState, FreeNodes, IterationSettings, Prescription, StepReport, StepWorkspace,
-    DEFAULT_ANDERSON_DEPTH,
+use super::anderson::{Anderson, DEFAULT_DEPTH};
+use super::constraints::{ConstraintFactor, PointConstraint};
+use super::fixed_point::{largest_correction, mix_update, Convergence};
+use super::problem::{
+    last_residual, residual, DynamicState, FreeNodes, IterationSettings, Prescription,
+    ResidualWorkspace, StepReport,
 };
 use crate::body::frame::{node, set_node};
 use crate::body::Body;
@@ -301,7 +304,8 @@ pub struct RadauProblem<'a> {
     pub prescribe: Prescription<'a>,
 }
 
-/// Work vectors of a Radau step (allocated once: a step allocates nothing).
+/// Work vectors of a Radau step besides the residual's (allocated once: a step allocates
+/// nothing).
 pub struct RadauWorkspace {
     /// The three stage states (all nodes; the clamped ones prescribed at the stage times).
     stages: Vec<DynamicState>,
@@ -314,34 +318,25 @@ pub struct RadauWorkspace {
     /// `ΔZ`, in metres).
     update: Vec<f64>,
     anderson: Anderson,
+    /// The right-hand sides of the real and the complex block, then their solutions.
     real_rhs: Vec<f64>,
     complex_rhs: Vec<c64>,
-    external: Vec<f64>,
-    inertia: Vec<f64>,
-    internal: Vec<f64>,
+    /// The state at the start of the step.
     previous: DynamicState,
 }
 
 impl RadauWorkspace {
-    /// Workspace with [`DEFAULT_ANDERSON_DEPTH`].
+    /// Workspace with Anderson's acceleration of the default depth ([`DEFAULT_DEPTH`]).
     pub fn new(body: &Body, free: &FreeNodes) -> RadauWorkspace {
-        Self::with_anderson_depth(body, free, DEFAULT_ANDERSON_DEPTH)
+        Self::with_anderson_depth(body, free, DEFAULT_DEPTH)
     }
 
     /// Workspace with Anderson's acceleration of history `depth` (0: the plain simplified
     /// Newton iteration) over all three stages' increments.
     pub fn with_anderson_depth(body: &Body, free: &FreeNodes, depth: usize) -> RadauWorkspace {
-        let n3 = body.reference.len();
         let nf3 = free.dof_count();
         let nm = free.multiplier_count();
-        let state = DynamicState {
-            time: 0.0,
-            position: vec![0.0; n3],
-            velocity: vec![0.0; n3],
-            acceleration: vec![0.0; n3],
-            pseudo_acceleration: vec![0.0; n3],
-            multipliers: vec![0.0; nm],
-        };
+        let state = DynamicState::zeros(body.reference.len(), nm);
         RadauWorkspace {
             stages: vec![state.clone(), state.clone(), state.clone()],
             increments: vec![0.0; 3 * nf3 + 3 * nm],
@@ -350,19 +345,22 @@ impl RadauWorkspace {
             anderson: Anderson::new(depth, 3 * nf3 + 3 * nm, 3 * nf3),
             real_rhs: vec![0.0; nf3],
             complex_rhs: vec![c64::new(0.0, 0.0); nf3],
-            external: vec![0.0; n3],
-            inertia: vec![0.0; n3],
-            internal: vec![0.0; n3],
             previous: state,
         }
     }
+
+    /// Stage `s`'s multipliers `Λ_s` in the iterate.
+    fn stage_multipliers(&self, nf3: usize, nm: usize, s: usize) -> &[f64] {
+        let start = 3 * nf3 + s * nm;
+        &self.increments[start..start + nm]
+    }
 }
 
-/// One Radau IIA step `t → t + h` of `state` (no allocation). `forces` provides the force
-/// scratch (and the
-/// geometric stiffness of stiffening, if set): after the step it holds `ū`, `g` of stage 3
-/// (`t_{n+1}`). On failure (no convergence in `settings.max_iterations`, non-finite values)
-/// `state` is left as it was and the error is an [`crate::ErrorKind::Discard`].
+/// One Radau IIA step `t → t + h` of `state` (no allocation). `forces` holds the residual's
+/// vectors and the geometric stiffness of stiffening, if set: after the step its force scratch
+/// holds `ū`, `g` of stage 3 (`t_{n+1}`). On failure (no convergence in
+/// `settings.max_iterations`, non-finite values) `state` is left as it was and the error is an
+/// [`crate::ErrorKind::Discard`].
 pub fn step(
     problem: &RadauProblem,
     matrix: &mut RadauMatrix,
@@ -370,7 +368,7 @@ pub fn step(
     h: f64,
     state: &mut DynamicState,
     ws: &mut RadauWorkspace,
-    forces: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
 ) -> Result<StepReport> {
     ws.previous.copy_from(state);
     let result = iterate(problem, matrix, settings, h, state, ws, forces);
@@ -380,7 +378,8 @@ pub fn step(
     result
 }
 
-/// Stage `s`'s free positions, velocities and accelerations from the increments `Z`.
+/// Stage `s`'s free positions, velocities and accelerations from the increments `Z`:
+/// `X_s = x_n + Z_s`, `V_s = h⁻¹ (A⁻¹ Z)_s`, `Ẍ_s = h⁻² (A⁻² Z)_s − h⁻¹ (A⁻¹𝟙)_s ẋ_n`.
 fn stage_kinematics(
     tableau: &RadauIIA,
     free: &FreeNodes,
@@ -405,6 +404,9 @@ fn stage_kinematics(
     }
 }
 
+/// The simplified Newton iteration on `[Z, Λ]` from the predictor: per iteration the stage
+/// residuals, the transformed solve of the two blocks (with the constraints' Schur complements),
+/// the stopping test ([`Convergence`]) and Anderson's mixing over all stages.
 fn iterate(
     problem: &RadauProblem,
     matrix: &mut RadauMatrix,
@@ -412,22 +414,43 @@ fn iterate(
     h: f64,
     state: &mut DynamicState,
     ws: &mut RadauWorkspace,
-    forces: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
 ) -> Result<StepReport> {
-    let RadauProblem {
-        body,
-        free,
-        loads,
-        prescribe,
-    } = *problem;
     let tableau = matrix.tableau;
+    predict(problem, &tableau, h, ws);
+    let mut convergence =
+        Convergence::new("radauIIA ", settings, ws.previous.time + h, h).correction_only();
+    ws.anderson.reset();
+    for iteration in 1..=settings.max_iterations {
+        let rotation = stage_residuals(problem, &tableau, h, ws, forces);
+        matrix.solve_transformed(problem.free, &rotation, ws);
+        let largest = stage_update(problem.free, &tableau, &rotation, ws);
+        let converged = convergence.converged(largest)?;
+        mix_update(&mut ws.anderson, converged, &ws.increments, &mut ws.update);
+        for (z, dz) in ws.increments.iter_mut().zip(&ws.update) {
+            *z += dz;
+        }
+        if converged {
+            finish(problem.free, &tableau, h, state, ws);
+            return Ok(StepReport {
+                iterations: iteration,
+                last_correction: convergence.last_correction(),
+            });
+        }
+    }
+    Err(convergence.failure())
+}
+
+/// The stage states at `t_n + c_i h` with the clamped nodes prescribed there, and the predictor
+/// `Z_i = c_i h ẋ_n + ½ (c_i h)² ẍ_n`, `Λ_i = λ_n`.
+fn predict(problem: &RadauProblem, tableau: &RadauIIA, h: f64, ws: &mut RadauWorkspace) {
+    let free = problem.free;
     let nf3 = free.dof_count();
     let t0 = ws.previous.time;
-    // Clamped nodes at the stage times; predictor Z_i = c_i h ẋ_n + ½ (c_i h)² ẍ_n.
     for s in 0..3 {
         ws.stages[s].copy_from(&ws.previous);
         ws.stages[s].time = t0 + tableau.c[s] * h;
-        prescribe(ws.stages[s].time, &mut ws.stages[s]);
+        (problem.prescribe)(ws.stages[s].time, &mut ws.stages[s]);
         let tau = tableau.c[s] * h;
         for (k, &i) in free.nodes.iter().enumerate() {
             for d in 0..3 {
@@ -437,48 +460,59 @@ fn iterate(
             }
         }
     }
-    // Stage multipliers: Λ_s = λ_n.
     let nm = free.multiplier_count();
     for s in 0..3 {
         let start = 3 * nf3 + s * nm;
         ws.increments[start..start + nm].copy_from_slice(&ws.previous.multipliers);
     }
-    let mut last_correction = f64::INFINITY;
-    ws.anderson.reset();
-    for iteration in 1..=settings.max_iterations {
-        // Stage residuals r_s = M Ẍ_s + f(X_s, V_s) − f_ext(t_s, X_s) on the free DOFs.
-        let mut rotation = [Matrix3::identity(); 3];
-        for (s, stage_rotation) in rotation.iter_mut().enumerate() {
-            stage_kinematics(&tableau, free, h, s, ws);
-            let stage = &ws.stages[s];
-            let (k_g, scratch) = forces.force_parts();
-            let kin = body.internal_force(
-                &stage.position,
-                &stage.velocity,
-                k_g,
-                scratch,
-                &mut ws.internal,
-            );
-            *stage_rotation = kin.frame.rotation;
-            let start = 3 * nf3 + s * nm;
-            add_constraint_forces(
-                &free.constraints,
-                &ws.increments[start..start + nm],
-                &mut ws.internal,
-            );
-            ws.external.fill(0.0);
-            loads(stage.time, &stage.position, &mut ws.external);
-            body.mass_times(&stage.acceleration, &mut ws.inertia);
-            for (k, &i) in free.nodes.iter().enumerate() {
-                for d in 0..3 {
-                    let g = 3 * i + d;
-                    ws.residuals[s * nf3 + 3 * k + d] =
-                        ws.internal[g] + ws.inertia[g] - ws.external[g];
-                }
-            }
+}
+
+/// The stage residuals `r_s = M Ẍ_s + f(X_s, V_s) + CᵀΛ_s − f_ext(t_s, X_s)` on the free DOFs
+/// (into `ws.residuals`, [`residual`]), and each stage's co-moving frame `R_s`.
+fn stage_residuals(
+    problem: &RadauProblem,
+    tableau: &RadauIIA,
+    h: f64,
+    ws: &mut RadauWorkspace,
+    forces: &mut ResidualWorkspace,
+) -> [Matrix3<f64>; 3] {
+    let RadauProblem {
+        body, free, loads, ..
+    } = *problem;
+    let (nf3, nm) = (free.dof_count(), free.multiplier_count());
+    let mut rotation = [Matrix3::identity(); 3];
+    for (s, stage_rotation) in rotation.iter_mut().enumerate() {
+        stage_kinematics(tableau, free, h, s, ws);
+        let start = 3 * nf3 + s * nm;
+        ws.stages[s]
+            .multipliers
+            .copy_from_slice(&ws.increments[start..start + nm]);
+        let stage = &ws.stages[s];
+        let stage_loads = |x: &[f64], f: &mut [f64]| loads(stage.time, x, f);
+        let kin = residual(body, free, stage, &stage_loads, forces);
+        *stage_rotation = kin.frame.rotation;
+        let r = last_residual(forces);
+        let stage_residual = &mut ws.residuals[s * nf3..(s + 1) * nf3];
+        for (k, &i) in free.nodes.iter().enumerate() {
+            stage_residual[3 * k..3 * k + 3].copy_from_slice(&r[3 * i..3 * i + 3]);
         }
-        // Each stage's residual into its own co-moving frame, then T⁻¹ across the stages; solve.
-        let ti = tableau.t_inv;
+    }
+    rotation
+}
+
+impl RadauMatrix {
+    /// The transformed solve of an iteration: each stage's residual rotated into its frame
+    /// (`R_sᵀ r_s`), `w = (T⁻¹ ⊗ I) (R_sᵀ r_s)_s`; the real block `S_γ δ_0 = w_0` and the complex
+    /// one `S_μ (δ_1 + i δ_2) = w_1 + i w_2` (with the point constraints' Schur complements,
+    /// which also set `ΔΛ` in `ws.update`); the solutions `δ` in `ws.real_rhs`, `ws.complex_rhs`.
+    fn solve_transformed(
+        &mut self,
+        free: &FreeNodes,
+        rotation: &[Matrix3<f64>; 3],
+        ws: &mut RadauWorkspace,
+    ) {
+        let ti = self.tableau.t_inv;
+        let nf3 = free.dof_count();
         for k in 0..free.nodes.len() {
             let r: [Vector3<f64>; 3] = std::array::from_fn(|s| {
                 rotation[s].transpose() * node(&ws.residuals[s * nf3..(s + 1) * nf3], k)
@@ -490,127 +524,154 @@ fn iterate(
                 *value = c64::new(w[1][d], w[2][d]);
             }
         }
-        matrix
-            .real
-            .solve_in_place(&mut ws.real_rhs, &mut matrix.real_workspace);
-        matrix.complex.solve_in_place(&mut ws.complex_rhs);
-        if let Some(sc) = &mut matrix.constraints {
-            // Constraint errors g_s = C X_s − d in the stage frames, T⁻¹ across the stages:
-            // q_k; then μ_k = (C Z_k)⁻¹ (C S_k⁻¹ w_k − q_k), y_k = S_k⁻¹ w_k − Z_k μ_k.
-            for (p, c) in free.constraints.iter().enumerate() {
-                let g: [Vector3<f64>; 3] = std::array::from_fn(|s| {
-                    rotation[s].transpose() * (c.centroid(&ws.stages[s].position) - c.target)
-                });
-                let q: [Vector3<f64>; 3] = std::array::from_fn(|m| {
-                    ti[(m, 0)] * g[0] + ti[(m, 1)] * g[1] + ti[(m, 2)] * g[2]
-                });
-                let (mut cy_real, mut cy_complex) =
-                    (Vector3::<f64>::zeros(), [c64::new(0.0, 0.0); 3]);
-                for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
-                    for d in 0..3 {
-                        cy_real[d] += w * ws.real_rhs[row + d];
-                        cy_complex[d] += ws.complex_rhs[row + d] * w;
-                    }
-                }
-                for d in 0..3 {
-                    sc.real_error[3 * p + d] = cy_real[d] - q[0][d];
-                    sc.complex_error[3 * p + d] = cy_complex[d] - c64::new(q[1][d], q[2][d]);
-                }
-            }
-            let m = sc.real_error.len();
-            for i in 0..m {
-                sc.real_mu[i] = (0..m)
-                    .map(|j| sc.real.schur_inverse[(i, j)] * sc.real_error[j])
-                    .sum();
-                sc.complex_mu[i] = (0..m)
-                    .map(|j| sc.complex_schur_inverse[(i, j)] * sc.complex_error[j])
-                    .sum();
-            }
-            let n = nf3;
-            for col in 0..m {
-                let (mu_r, mu_c) = (sc.real_mu[col], sc.complex_mu[col]);
-                let zr = &sc.real.z[col * n..(col + 1) * n];
-                for (y, z) in ws.real_rhs.iter_mut().zip(zr) {
-                    *y -= z * mu_r;
-                }
-                let zc = &sc.complex_z[col * n..(col + 1) * n];
-                for (y, z) in ws.complex_rhs.iter_mut().zip(zc) {
-                    *y -= z * mu_c;
-                }
-            }
-            // ΔΛ_s = −R_s Σ_k T_sk μ_k (per constraint).
-            let t = tableau.t;
-            for p in 0..free.constraints.len() {
-                let mu0 = Vector3::new(
-                    sc.real_mu[3 * p],
-                    sc.real_mu[3 * p + 1],
-                    sc.real_mu[3 * p + 2],
-                );
-                let mu1 = Vector3::from_fn(|d, _| sc.complex_mu[3 * p + d].re);
-                let mu2 = Vector3::from_fn(|d, _| sc.complex_mu[3 * p + d].im);
-                for s in 0..3 {
-                    let dl = -(rotation[s] * (t[(s, 0)] * mu0 + t[(s, 1)] * mu1 + t[(s, 2)] * mu2));
-                    let start = 3 * nf3 + s * nm + 3 * p;
-                    ws.update[start..start + 3].copy_from_slice(dl.as_slice());
-                }
-            }
-        }
-        // ΔZ_s = −R_s Σ_k T_sk δ_k.
-        let t = tableau.t;
-        let mut largest: f64 = 0.0;
-        let mut finite = true;
-        for k in 0..free.nodes.len() {
-            let w0 = node(&ws.real_rhs, k);
-            let (mut w1, mut w2) = (Vector3::zeros(), Vector3::zeros());
-            for d in 0..3 {
-                w1[d] = ws.complex_rhs[3 * k + d].re;
-                w2[d] = ws.complex_rhs[3 * k + d].im;
-            }
-            for s in 0..3 {
-                let dz = -(rotation[s] * (t[(s, 0)] * w0 + t[(s, 1)] * w1 + t[(s, 2)] * w2));
-                // (f64::max drops NaN: check finiteness on its own.)
-                finite &= dz.iter().all(|v| v.is_finite());
-                largest = largest.max(dz.amax());
-                set_node(&mut ws.update[s * nf3..(s + 1) * nf3], k, &dz);
-            }
-        }
-        // Anderson's acceleration of the fixed-point map Z ↦ Z + ΔZ (its iterate: all stages).
-        if finite && largest > settings.absolute_tolerance {
-            ws.anderson.accelerate(&ws.increments, &mut ws.update);
-        }
-        for (z, dz) in ws.increments.iter_mut().zip(&ws.update) {
-            *z += dz;
-        }
-        if !(finite && largest.is_finite()) {
-            return Err(Error::discard(format!(
-                "radauIIA step to t = {} (h = {h}): the iteration produced a non-finite correction",
-                t0 + h
-            )));
-        }
-        last_correction = largest;
-        if largest <= settings.absolute_tolerance {
-            stage_kinematics(&tableau, free, h, 2, ws);
-            let end = &ws.stages[2];
-            state.time = t0 + h;
-            state.position.copy_from_slice(&end.position);
-            state.velocity.copy_from_slice(&end.velocity);
-            state.acceleration.copy_from_slice(&end.acceleration);
-            state.pseudo_acceleration.copy_from_slice(&end.acceleration);
-            state
-                .multipliers
-                .copy_from_slice(&ws.increments[3 * nf3 + 2 * nm..3 * nf3 + 3 * nm]);
-            return Ok(StepReport {
-                iterations: iteration,
-                last_correction,
-            });
+        self.real
+            .solve_in_place(&mut ws.real_rhs, &mut self.real_workspace);
+        self.complex.solve_in_place(&mut ws.complex_rhs);
+        if let Some(sc) = &mut self.constraints {
+            sc.constraint_errors(free, &self.tableau, rotation, ws);
+            sc.solve_schur();
+            sc.project(nf3, ws);
+            sc.multiplier_update(free, &self.tableau, rotation, ws);
         }
     }
-    Err(Error::discard(format!(
-        "radauIIA step to t = {} (h = {h}) did not converge in {} iterations (last position correction {last_correction:.3e} m, tolerance {:.3e} m)",
-        t0 + h,
-        settings.max_iterations,
-        settings.absolute_tolerance
-    )))
+}
+
+impl StageConstraints {
+    /// The constraint errors of the blocks' unconstrained solutions: with the stage errors
+    /// `g_s = R_sᵀ (C X_s − d)` in the stage frames and `q = (T⁻¹ ⊗ I) g`, `C y_k − q_k` for the
+    /// real block (`k = 0`) and the complex one (`q_1 + i q_2`).
+    fn constraint_errors(
+        &mut self,
+        free: &FreeNodes,
+        tableau: &RadauIIA,
+        rotation: &[Matrix3<f64>; 3],
+        ws: &RadauWorkspace,
+    ) {
+        let ti = tableau.t_inv;
+        for (p, c) in free.constraints.iter().enumerate() {
+            let g: [Vector3<f64>; 3] = std::array::from_fn(|s| {
+                rotation[s].transpose() * (c.centroid(&ws.stages[s].position) - c.target)
+            });
+            let q: [Vector3<f64>; 3] =
+                std::array::from_fn(|m| ti[(m, 0)] * g[0] + ti[(m, 1)] * g[1] + ti[(m, 2)] * g[2]);
+            let (mut cy_real, mut cy_complex) = (Vector3::<f64>::zeros(), [c64::new(0.0, 0.0); 3]);
+            for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
+                for d in 0..3 {
+                    cy_real[d] += w * ws.real_rhs[row + d];
+                    cy_complex[d] += ws.complex_rhs[row + d] * w;
+                }
+            }
+            for d in 0..3 {
+                self.real_error[3 * p + d] = cy_real[d] - q[0][d];
+                self.complex_error[3 * p + d] = cy_complex[d] - c64::new(q[1][d], q[2][d]);
+            }
+        }
+    }
+
+    /// `μ_k = (C Z_k)⁻¹ (C S_k⁻¹ w_k − q_k)` for both blocks.
+    fn solve_schur(&mut self) {
+        let m = self.real_error.len();
+        for i in 0..m {
+            self.real_mu[i] = (0..m)
+                .map(|j| self.real.schur_inverse[(i, j)] * self.real_error[j])
+                .sum();
+            self.complex_mu[i] = (0..m)
+                .map(|j| self.complex_schur_inverse[(i, j)] * self.complex_error[j])
+                .sum();
+        }
+    }
+
+    /// The constrained solutions `y_k = S_k⁻¹ w_k − Z_k μ_k` (in place, `n` free DOFs).
+    fn project(&self, n: usize, ws: &mut RadauWorkspace) {
+        for col in 0..self.real_error.len() {
+            let (mu_r, mu_c) = (self.real_mu[col], self.complex_mu[col]);
+            let zr = &self.real.z[col * n..(col + 1) * n];
+            for (y, z) in ws.real_rhs.iter_mut().zip(zr) {
+                *y -= z * mu_r;
+            }
+            let zc = &self.complex_z[col * n..(col + 1) * n];
+            for (y, z) in ws.complex_rhs.iter_mut().zip(zc) {
+                *y -= z * mu_c;
+            }
+        }
+    }
+
+    /// The stage multipliers' correction `ΔΛ_s = −R_s Σ_k T_sk μ_k` (per constraint) into
+    /// `ws.update`.
+    fn multiplier_update(
+        &self,
+        free: &FreeNodes,
+        tableau: &RadauIIA,
+        rotation: &[Matrix3<f64>; 3],
+        ws: &mut RadauWorkspace,
+    ) {
+        let t = tableau.t;
+        let (nf3, nm) = (free.dof_count(), free.multiplier_count());
+        for p in 0..free.constraints.len() {
+            let mu0 = Vector3::new(
+                self.real_mu[3 * p],
+                self.real_mu[3 * p + 1],
+                self.real_mu[3 * p + 2],
+            );
+            let mu1 = Vector3::from_fn(|d, _| self.complex_mu[3 * p + d].re);
+            let mu2 = Vector3::from_fn(|d, _| self.complex_mu[3 * p + d].im);
+            for s in 0..3 {
+                let dl = -(rotation[s] * (t[(s, 0)] * mu0 + t[(s, 1)] * mu1 + t[(s, 2)] * mu2));
+                let start = 3 * nf3 + s * nm + 3 * p;
+                ws.update[start..start + 3].copy_from_slice(dl.as_slice());
+            }
+        }
+    }
+}
+
+/// The increments' correction `ΔZ_s = −R_s Σ_k T_sk δ_k` into `ws.update` from the blocks'
+/// solutions `δ_0` (real) and `δ_1 + i δ_2` (complex); returns the largest entry
+/// ([`largest_correction`]).
+fn stage_update(
+    free: &FreeNodes,
+    tableau: &RadauIIA,
+    rotation: &[Matrix3<f64>; 3],
+    ws: &mut RadauWorkspace,
+) -> f64 {
+    let t = tableau.t;
+    let nf3 = free.dof_count();
+    let mut largest: f64 = 0.0;
+    for k in 0..free.nodes.len() {
+        let w0 = node(&ws.real_rhs, k);
+        let (mut w1, mut w2) = (Vector3::zeros(), Vector3::zeros());
+        for d in 0..3 {
+            w1[d] = ws.complex_rhs[3 * k + d].re;
+            w2[d] = ws.complex_rhs[3 * k + d].im;
+        }
+        for s in 0..3 {
+            let dz = -(rotation[s] * (t[(s, 0)] * w0 + t[(s, 1)] * w1 + t[(s, 2)] * w2));
+            largest = largest_correction(largest, dz.as_slice());
+            set_node(&mut ws.update[s * nf3..(s + 1) * nf3], k, &dz);
+        }
+    }
+    largest
+}
+
+/// The converged step's end state: stage 3 (`c_3 = 1`, stiffly accurate), `x_{n+1} = X_3`,
+/// `ẋ_{n+1} = V_3`, `ẍ_{n+1} = Ẍ_3`, `λ_{n+1} = Λ_3`.
+fn finish(
+    free: &FreeNodes,
+    tableau: &RadauIIA,
+    h: f64,
+    state: &mut DynamicState,
+    ws: &mut RadauWorkspace,
+) {
+    stage_kinematics(tableau, free, h, 2, ws);
+    let end = &ws.stages[2];
+    state.time = ws.previous.time + h;
+    state.position.copy_from_slice(&end.position);
+    state.velocity.copy_from_slice(&end.velocity);
+    state.acceleration.copy_from_slice(&end.acceleration);
+    state.pseudo_acceleration.copy_from_slice(&end.acceleration);
+    let (nf3, nm) = (free.dof_count(), free.multiplier_count());
+    state
+        .multipliers
+        .copy_from_slice(ws.stage_multipliers(nf3, nm, 2));
 }
 
 #[cfg(test)]

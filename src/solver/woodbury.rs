@@ -21,7 +21,7 @@
 //! block products) and the 3×3 `(I + H⁻ᵀ A Y)⁻¹` once per step, at the predictor; each iteration
 //! then adds O(N) work to its one solve.
 
-use super::generalized_alpha::FreeNodes;
+use super::problem::FreeNodes;
 use crate::body::frame::node;
 use crate::body::Body;
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};

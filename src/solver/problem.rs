@@ -1,0 +1,249 @@
+//! The vocabulary every time integration scheme shares: the equations of motion on the free
+//! DOFs, the state they advance, the residual, and what a step reports.
+//!
+//! The body's `N` nodes carry positions `x`, velocities `ẋ` and accelerations `ẍ` (flat `3N`).
+//! The clamped nodes (fixed supports, motion interfaces) follow a prescription; the free ones
+//! satisfy
+//!
+//! ```text
+//! r(x, ẋ, ẍ, λ) = M ẍ + f(x, ẋ) + Cᵀλ − f_ext(x) = 0        (free DOFs)
+//! C x = d                                                   (point constraints: pins, hinges)
+//! ```
+//!
+//! with `M = Ms ⊗ I3` the consistent mass, `f` the body's internal force (elastic, damping,
+//! `f_nl`, stiffening), `C` the point constraints' selection Jacobian and `λ` their Lagrange
+//! multipliers (the constraint load on the body is `−Cᵀλ`), `f_ext` the external loads. Each
+//! scheme (generalized-α, Radau IIA, central difference: the modules above this one)
+//! discretises `ẋ`, `ẍ` in time and drives `r` to zero on the free DOFs; they all evaluate it
+//! with [`residual`] in a [`ResidualWorkspace`].
+
+use super::constraints::{add_constraint_forces, PointConstraint};
+use crate::body::{Body, BodyKinematics, ForceScratch};
+use crate::error::{Error, Result};
+use crate::linalg::SymmetricCsr;
+
+/// Which nodes move: the others are clamped (a `fixed` support) and keep their positions.
+#[derive(Debug, Clone)]
+pub struct FreeNodes {
+    /// Free node indices, ascending; free node `k` owns rows `3k..3k+3` of the reduced system.
+    pub nodes: Vec<usize>,
+    /// The clamped (prescribed) nodes, ascending.
+    pub clamped: Vec<usize>,
+    /// `M ⊗ I3` restricted to the free DOFs.
+    pub mass: SymmetricCsr,
+    /// `K` restricted to the free DOFs.
+    pub stiffness: SymmetricCsr,
+    /// `Ms` restricted to the free nodes (scalar).
+    pub scalar_mass: SymmetricCsr,
+    /// Point constraints (pins) on free nodes, solved with Lagrange multipliers.
+    pub constraints: Vec<PointConstraint>,
+}
+
+impl FreeNodes {
+    /// Free nodes of `body` when `clamped` nodes are held.
+    pub fn new(body: &Body, clamped: &[bool]) -> FreeNodes {
+        let nodes: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
+        let dofs = node_dofs(&nodes);
+        let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
+        let stiffness = body.stiffness_matrix.submatrix(&dofs);
+        let scalar_mass = body.mass_matrix.submatrix(&nodes);
+        FreeNodes {
+            nodes,
+            clamped: (0..body.node_count()).filter(|&i| clamped[i]).collect(),
+            mass,
+            stiffness,
+            scalar_mass,
+            constraints: Vec::new(),
+        }
+    }
+
+    /// The global DOFs of the free nodes, in the order of the reduced system.
+    pub fn dofs(&self) -> Vec<usize> {
+        node_dofs(&self.nodes)
+    }
+
+    /// Adds a point constraint holding the weighted centroid of `nodes` (weights `weights`, any
+    /// positive scale) at `target` (m). Error if a node is clamped.
+    pub fn add_point_constraint(
+        &mut self,
+        name: &str,
+        nodes: &[usize],
+        weights: &[f64],
+        target: nalgebra::Vector3<f64>,
+    ) -> Result<()> {
+        let total: f64 = weights.iter().sum();
+        let mut free_rows = Vec::with_capacity(nodes.len());
+        for &n in nodes {
+            match self.nodes.binary_search(&n) {
+                Ok(k) => free_rows.push(3 * k),
+                Err(_) => {
+                    return Err(Error::new(format!(
+                        "interface '{name}': node {n} is also held by a fixed support or motion interface"
+                    )))
+                }
+            }
+        }
+        self.constraints.push(PointConstraint {
+            nodes: nodes.to_vec(),
+            weights: weights.iter().map(|w| w / total).collect(),
+            free_rows,
+            target,
+        });
+        Ok(())
+    }
+
+    /// Number of Lagrange multipliers (3 per point constraint).
+    pub fn multiplier_count(&self) -> usize {
+        3 * self.constraints.len()
+    }
+
+    /// Number of free DOFs.
+    pub fn dof_count(&self) -> usize {
+        3 * self.nodes.len()
+    }
+}
+
+/// The DOFs `3i, 3i+1, 3i+2` of each node `i` of `nodes`.
+fn node_dofs(nodes: &[usize]) -> Vec<usize> {
+    nodes
+        .iter()
+        .flat_map(|&i| [3 * i, 3 * i + 1, 3 * i + 2])
+        .collect()
+}
+
+/// Positions, velocities, accelerations and pseudo-accelerations (flat `3N`) at `time`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DynamicState {
+    pub time: f64,
+    pub position: Vec<f64>,
+    pub velocity: Vec<f64>,
+    pub acceleration: Vec<f64>,
+    pub pseudo_acceleration: Vec<f64>,
+    /// Lagrange multipliers of the point constraints (N, global; 3 per constraint): the
+    /// constraint load on the body is `−Cᵀλ`.
+    pub multipliers: Vec<f64>,
+}
+
+impl DynamicState {
+    /// A state at rest at the origin with `dofs` entries (`3N`) and `multipliers` multipliers.
+    pub fn zeros(dofs: usize, multipliers: usize) -> DynamicState {
+        DynamicState {
+            time: 0.0,
+            position: vec![0.0; dofs],
+            velocity: vec![0.0; dofs],
+            acceleration: vec![0.0; dofs],
+            pseudo_acceleration: vec![0.0; dofs],
+            multipliers: vec![0.0; multipliers],
+        }
+    }
+
+    /// Copies `other` into `self` without allocating.
+    pub fn copy_from(&mut self, other: &DynamicState) {
+        self.time = other.time;
+        self.position.copy_from_slice(&other.position);
+        self.velocity.copy_from_slice(&other.velocity);
+        self.acceleration.copy_from_slice(&other.acceleration);
+        self.pseudo_acceleration
+            .copy_from_slice(&other.pseudo_acceleration);
+        self.multipliers.copy_from_slice(&other.multipliers);
+    }
+}
+
+/// What a step did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepReport {
+    pub iterations: usize,
+    /// Largest position correction of the last iteration (m).
+    pub last_correction: f64,
+}
+
+/// Settings of the fixed-point iteration of the implicit schemes (`fixed_point::Convergence`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IterationSettings {
+    /// Converged when the estimated position error of the iterate is below this (m): the
+    /// largest correction, or after the second iteration its estimated remaining error
+    /// (`fixed_point::remaining_error`).
+    pub absolute_tolerance: f64,
+    pub max_iterations: usize,
+}
+
+/// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.
+pub type Prescription<'a> = &'a dyn Fn(f64, &mut DynamicState);
+
+/// What a step of any scheme needs besides the state: the body, its free nodes and constraints,
+/// the external loads (`loads(x, f_ext)` adds them to a zeroed `f_ext`) and the prescription of
+/// the clamped nodes. (The scheme's coefficients live in its iteration matrix, the iteration
+/// settings are an argument of its `step`.)
+pub struct StepProblem<'a> {
+    pub body: &'a Body,
+    pub free: &'a FreeNodes,
+    pub loads: &'a dyn Fn(&[f64], &mut [f64]),
+    pub prescribe: Prescription<'a>,
+}
+
+/// The vectors and body scratch of a residual evaluation (allocated once: evaluating the
+/// residual allocates nothing). One per model, shared by whichever scheme steps it: its owner
+/// sets the geometric stiffness before a step and reads the force scratch after one.
+pub struct ResidualWorkspace {
+    /// The internal force `f(x, ẋ)`, then the residual `r` (full `3N`).
+    pub(super) internal: Vec<f64>,
+    /// The external loads `f_ext(x)` (full `3N`; scratch between residuals).
+    pub(super) external: Vec<f64>,
+    /// The inertia force `M ẍ` (full `3N`; scratch between residuals).
+    pub(super) inertia: Vec<f64>,
+    /// The body's force scratch: `ū`, `g` and the patch frames of the last residual.
+    pub(super) force_scratch: ForceScratch,
+    /// The geometric stiffness `K_G` of the current prestress (stiffening), if any: set by the
+    /// owner before a step, constant during it.
+    pub geometric_stiffness: Option<SymmetricCsr>,
+}
+
+impl ResidualWorkspace {
+    pub fn new(body: &Body) -> ResidualWorkspace {
+        let n3 = body.reference.len();
+        ResidualWorkspace {
+            internal: vec![0.0; n3],
+            external: vec![0.0; n3],
+            inertia: vec![0.0; n3],
+            force_scratch: body.force_scratch(),
+            geometric_stiffness: None,
+        }
+    }
+
+    /// The body's force scratch: `ū`, `g` of the last residual.
+    pub fn force_scratch(&self) -> &ForceScratch {
+        &self.force_scratch
+    }
+}
+
+/// The residual `r = M ẍ + f(x, ẋ) + Cᵀλ − f_ext(x)` (full `3N`, in `ws`, read it with
+/// [`last_residual`]), and the body's kinematics on the way. `loads(x, f_ext)` adds the
+/// external loads to a zeroed `f_ext`.
+pub fn residual(
+    body: &Body,
+    free: &FreeNodes,
+    state: &DynamicState,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    ws: &mut ResidualWorkspace,
+) -> BodyKinematics {
+    let kin = body.internal_force(
+        &state.position,
+        &state.velocity,
+        ws.geometric_stiffness.as_ref(),
+        &mut ws.force_scratch,
+        &mut ws.internal,
+    );
+    ws.external.fill(0.0);
+    loads(&state.position, &mut ws.external);
+    body.mass_times(&state.acceleration, &mut ws.inertia);
+    for k in 0..ws.internal.len() {
+        ws.internal[k] += ws.inertia[k] - ws.external[k];
+    }
+    add_constraint_forces(&free.constraints, &state.multipliers, &mut ws.internal);
+    kin
+}
+
+/// The residual left in `ws` by the last [`residual`] call.
+pub fn last_residual(ws: &ResidualWorkspace) -> &[f64] {
+    &ws.internal
+}
