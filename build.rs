@@ -169,9 +169,6 @@ fn main() {
         .unwrap();
     }
     out.push_str("];\n\n");
-    for e in &spec.enumerations {
-        write_enumeration(&mut out, e);
-    }
     out.push_str("/// Log categories: name and description.\n");
     out.push_str("pub const LOG_CATEGORIES: &[(&str, &str)] = &[\n");
     for c in &spec.log_categories {
@@ -189,6 +186,12 @@ fn main() {
 
     let dest = std::path::Path::new(&std::env::var("OUT_DIR").unwrap()).join("fixed_variables.rs");
     std::fs::write(dest, out).expect("write fixed_variables.rs");
+    let mut enumerations = String::new();
+    for e in &spec.enumerations {
+        write_enumeration(&mut enumerations, e);
+    }
+    let dest = std::path::Path::new(&std::env::var("OUT_DIR").unwrap()).join("enumerations.rs");
+    std::fs::write(dest, enumerations).expect("write enumerations.rs");
 }
 
 /// A Rust enum for an enumeration type of `variables.json`: one variant per item (the item's name

@@ -202,7 +202,7 @@ pub struct SolverSpec {
 }
 
 /// The time integration scheme (`solver.integrator`), the enumeration of `variables.json`.
-pub use super::variables::Integrator;
+pub use super::enumerations::Integrator;
 
 impl SolverSpec {
     fn default_step_size() -> f64 {

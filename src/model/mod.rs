@@ -2,6 +2,7 @@
 //! references, and the generated `modelDescription.xml`.
 
 pub mod body_file;
+pub mod enumerations;
 pub mod model_description;
 pub mod variables;
 

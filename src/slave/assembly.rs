@@ -12,7 +12,7 @@ use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::linalg::SymmetricCsr;
 use crate::model::category;
-use crate::model::variables::{Formulation, Integrator, Stiffening};
+use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
 use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;

@@ -3,7 +3,8 @@
 
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
-use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
+use crate::model::enumerations::{Formulation, Integrator, Stiffening};
+use crate::model::variables::FixedKey;
 use crate::model::{BodyFile, Target};
 use crate::solver::anderson::MAX_DEPTH;
 

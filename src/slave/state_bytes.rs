@@ -24,7 +24,8 @@
 use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, INTERFACE_SLOTS};
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
-use crate::model::variables::{FixedKey, Formulation, Integrator, Stiffening};
+use crate::model::enumerations::{Formulation, Integrator, Stiffening};
+use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
