@@ -29,7 +29,11 @@ impl Slave {
         let t_c = current_communication_point;
         let (n, h) = self.internal_steps(t_c, communication_step_size)?;
         let big_h = self.snapped_step(communication_step_size);
-        self.prepare_step(t_c, h)?;
+        // The FMU's own clock, which agrees with the importer's to a few ulps: steps are timed
+        // on it (not on `t_c`, which importers compute differently), so that the same inputs
+        // give the same bits in every importer.
+        let t0 = self.time();
+        self.prepare_step(h)?;
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
         // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
@@ -37,7 +41,7 @@ impl Slave {
         // H = 2e-4 s). Input derivatives give continuous loads instead.
         let mut result = Ok(());
         for i in 0..n {
-            result = self.internal_step(t_c, big_h, i, n, h);
+            result = self.internal_step(t0, big_h, i, n, h);
             if result.is_err() {
                 break;
             }
@@ -48,7 +52,7 @@ impl Slave {
         }
         match result {
             Ok(()) => {
-                self.finish_step(t_c, big_h, communication_step_size);
+                self.finish_step(t0, big_h);
                 Ok(())
             }
             Err(e) => Err(self.roll_back(t_c, communication_step_size, e)),
@@ -114,7 +118,7 @@ impl Slave {
     /// Everything a communication step needs before its first internal step: the driving
     /// frames, the factorization for `h` (on a cache miss; an error here leaves the state), the
     /// terms in force, the geometric stiffness of the current prestress and the backup.
-    fn prepare_step(&mut self, t_c: f64, h: f64) -> Result<()> {
+    fn prepare_step(&mut self, h: f64) -> Result<()> {
         self.update_driving_frames()?;
         self.prepare_step_size(h)?;
         let model = self
@@ -145,17 +149,16 @@ impl Slave {
         }
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
-        dynamics.state.time = t_c;
         Ok(())
     }
 
-    /// After a successful communication step of `big_h` (the importer's step
-    /// `communication_step_size`): the time, the loads the end state's accelerations belong to
-    /// (the inputs extrapolated to `t_c + H`), the strain watch and the results.
-    fn finish_step(&mut self, t_c: f64, big_h: f64, communication_step_size: f64) {
+    /// After a successful communication step of `big_h` from `t0`: the time, the loads the end
+    /// state's accelerations belong to (the inputs extrapolated to `t0 + H`), the strain watch
+    /// and the results.
+    fn finish_step(&mut self, t0: f64, big_h: f64) {
         self.last_step_size = big_h;
         let dynamics = self.dynamics.as_mut().unwrap();
-        dynamics.state.time = t_c + communication_step_size;
+        dynamics.state.time = t0 + big_h;
         dynamics.loads.clone_from(&self.inputs);
         for ((load, d), age) in dynamics
             .loads
@@ -167,7 +170,7 @@ impl Slave {
         }
         dynamics.gravity = self.parameters.gravity;
         self.outputs.valid = false;
-        self.watch_strain(t_c + communication_step_size);
+        self.watch_strain(t0 + big_h);
         if self.results.is_some() {
             self.write_results();
         }
@@ -217,14 +220,14 @@ impl Slave {
         Error { kind, message }
     }
 
-    /// Internal step `i` of `n` (of length `h`) of the communication step from `t_c` by `big_h`.
+    /// Internal step `i` of `n` (of length `h`) of the communication step from `t0` by `big_h`.
     /// If it does not converge it is redone as 2, 4, ... 2^[`MAX_STEP_HALVINGS`] steps (each
     /// halving logged under `logEvents`); the error of the last attempt is returned if none
     /// converges, with the state back at the start of this internal step. No allocation unless
     /// a step fails.
     pub(super) fn internal_step(
         &mut self,
-        t_c: f64,
+        t0: f64,
         big_h: f64,
         i: usize,
         n: usize,
@@ -242,7 +245,7 @@ impl Slave {
                     .get_or_insert_with(|| state.clone())
                     .copy_from(state);
             }
-            let result = self.advance(t_c, big_h, tau0, hs, m, i + 1 == n);
+            let result = self.advance(t0, big_h, tau0, hs, m, i + 1 == n);
             let e = match result {
                 Ok(()) => return Ok(()),
                 Err(e) => e,
@@ -257,7 +260,7 @@ impl Slave {
             if depth == MAX_STEP_HALVINGS {
                 return Err(Error::discard(format!(
                     "the internal step from t = {} (h = {h:e}) did not converge, nor when retried with {m} steps of h/{m} = {hs:e}: {}",
-                    t_c + tau0,
+                    t0 + tau0,
                     e.message
                 )));
             }
@@ -267,7 +270,7 @@ impl Slave {
                 category: category::EVENTS,
                 message: format!(
                     "internal step from t = {} (h = {hs:e}) did not converge ({}); retrying it as {} steps of {:e} s",
-                    t_c + tau0,
+                    t0 + tau0,
                     e.message,
                     1usize << depth,
                     h / (1usize << depth) as f64
@@ -277,14 +280,14 @@ impl Slave {
     }
 
     /// `m` internal steps of `hs` (prepared), from `tau0` after the
-    /// communication point `t_c`. Force inputs are taken at each internal step's end,
-    /// `u(t_c + τ) = u + u'·τ + u''·τ²/2` (the generalized-α scheme here satisfies the equations
+    /// communication point `t0`. Force inputs are taken at each internal step's end,
+    /// `u(t0 + τ) = u + u'·τ + u''·τ²/2` (the generalized-α scheme here satisfies the equations
     /// of motion at the end of each internal step, so this is where the load enters); the last
     /// internal step of the communication step uses `τ = big_h` exactly.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn advance(
         &mut self,
-        t_c: f64,
+        t0: f64,
         big_h: f64,
         tau0: f64,
         hs: f64,
@@ -317,7 +320,7 @@ impl Slave {
         };
         let driving = &self.driving;
         let prescribe = |t: f64, state: &mut DynamicState| {
-            prescribe_motion(body, interfaces, driving, t - t_c, state)
+            prescribe_motion(body, interfaces, driving, t - t0, state)
         };
         let problem = StepProblem {
             body,
@@ -327,7 +330,7 @@ impl Slave {
         };
         // Radau's stages sit inside the step: its loads take the time.
         let timed_loads = |t: f64, x: &[f64], f: &mut [f64]| {
-            tau.set(t - t_c);
+            tau.set(t - t0);
             loads(x, f)
         };
         let radau_problem = RadauProblem {
