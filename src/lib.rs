@@ -1,9 +1,11 @@
 //! flexbody: an elastic 3D finite-element body, moved with the absolute coordinate formulation
 //! with reduced strain (Gerstmayr & Irschik), exported as an FMI 2.0 co-simulation FMU.
 //!
-//! Data flows one way (DESIGN.md section 6):
-//! body file ([`model`]) → [`mesh`] → FE matrices ([`fem`]) → [`body`] → [`solver`] → [`slave`] →
-//! C ABI (`fmi2`). A layer knows only the layers before it; `unsafe` lives in `fmi2` only.
+//! Data flows one way: body file ([`model`]) → [`mesh`] → FE matrices ([`fem`]) → [`body`] →
+//! [`solver`] → [`slave`] → C ABI (`fmi2`). The modules are floors (docs/architecture.md,
+//! checked by `tests/floors.rs`): [`error`], [`linalg`], [`element`], [`mesh`], [`fem`],
+//! [`body`], [`solver`] and [`output`], [`model`], [`slave`], `fmi2`; each uses only the floors
+//! below it. `unsafe` lives in `fmi2` only.
 
 #![deny(unsafe_code)]
 

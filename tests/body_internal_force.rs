@@ -1,4 +1,4 @@
-//! The internal force of the ACF-RS body (DESIGN.md section 2) against finite differences of the
+//! The internal force of the ACF-RS body (docs/formulation.md, "The internal force") against finite differences of the
 //! strain energy `V = ½ ūᵀ K ū` on a rotated, deformed body; its balance (no net force or moment
 //! with `f_nl`); damping that leaves rigid motion undamped.
 

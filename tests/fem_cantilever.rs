@@ -1,4 +1,4 @@
-//! B1 of BENCHMARKS.md: the clamped steel cantilever (L = 1 m, 0.02 × 0.02 m, E = 2.1e11 Pa,
+//! B1 of docs/benchmarks.md: the clamped steel cantilever (L = 1 m, 0.02 × 0.02 m, E = 2.1e11 Pa,
 //! ν = 0.3, ρ = 7850 kg/m³), root face x = 0 clamped by removing its DOFs, F = 10 N in −y spread
 //! over the tip-face nodes with weights proportional to their HRZ-lumped masses; the tip
 //! deflection is the mean y-displacement of the tip-face nodes with the same weights.

@@ -1,4 +1,4 @@
-//! Tetrahedra and Gmsh meshes on B1 of BENCHMARKS.md (the clamped steel cantilever, 1 m ×
+//! Tetrahedra and Gmsh meshes on B1 of docs/benchmarks.md (the clamped steel cantilever, 1 m ×
 //! 20 mm × 20 mm, F = 10 N in −y on the tip face), and the node order of imported elements.
 //!
 //! Meshes: `tests/data/*.msh`, made by `tests/data/make_meshes.py` (Gmsh). The tet4 meshes are

@@ -1,5 +1,5 @@
 //! The hot path: after the first step at a step size, `do_step` and reading the outputs allocate
-//! nothing (DEVELOPERS.md). A counting global allocator watches this test binary.
+//! nothing (docs/architecture.md, "Rules of the house"). A counting global allocator watches this test binary.
 
 mod common;
 use common::*;

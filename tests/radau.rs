@@ -393,7 +393,7 @@ fn the_body_file_selects_radau() {
     assert_eq!(s.cached_step_sizes(), vec![1e-3]);
 }
 
-/// B3 (spin-up on a hub, BENCHMARKS.md) with Radau: the motion interface's nodes are prescribed
+/// B3 (spin-up on a hub, docs/benchmarks.md) with Radau: the motion interface's nodes are prescribed
 /// at the stage times, the iteration matrices rotate with the body through several turns (each
 /// stage with its own frame).
 /// Against generalized-α (ρ∞ = 0.9) at the same h = 1e-2 s: both schemes are converged on the

@@ -105,7 +105,7 @@ fn stiff_root_half_deflects_as_two_segment_beam() {
         "{two_error} vs {half_error}"
     );
     // The discretisation error itself: the 3D solid is stiffer than beam theory at the clamped
-    // root (Poisson effects, BENCHMARKS.md) and the mesh errs stiff; the uniform full beam on
+    // root (Poisson effects, docs/benchmarks.md) and the mesh errs stiff; the uniform full beam on
     // these elements lands at −0.66 % of Timoshenko, the half beam (half the slenderness,
     // twice the root's share) at −1.3 %.
     assert!((-0.02..0.0).contains(&half_error), "{half_error}");

@@ -102,7 +102,7 @@ fn b3_spin_up(body: flexbody::model::BodyFile) -> Vec<f64> {
 
 #[test]
 fn a_thin_slender_section_follows_the_square_one() {
-    // B3's stress variant (BENCHMARKS.md): Kane's material (E = 7e10, ρ = 3000) on a thin
+    // B3's stress variant (docs/benchmarks.md): Kane's material (E = 7e10, ρ = 3000) on a thin
     // rectangle 77.46 mm (in the plane of rotation) × 5.164 mm with the same EI and ρA as the
     // 0.1 m square of the primary version: beam theory predicts the same in-plane response.
     // Elements 250 mm × 77 mm × 5 mm (aspect ratio 48) test the conditioning; shear and the

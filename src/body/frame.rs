@@ -1,4 +1,4 @@
-//! The co-moving frame `(c, R)` of DESIGN.md section 2: `c = Σ w_i x_i / Σ w_i`, `R` the weighted
+//! The co-moving frame `(c, R)` (docs/formulation.md, "The co-moving frame"): `c = Σ w_i x_i / Σ w_i`, `R` the weighted
 //! best-fit rotation, i.e. the rotation factor of the polar decomposition of
 //! `A = Σ w_i (x_i − c) X̄_iᵀ` with `X̄_i = X_i − X_c`.
 
@@ -158,7 +158,7 @@ impl FrameWeights {
     }
 
     /// `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×` for the frame `frame` of positions `x` (≈ minus the
-    /// weighted inertia tensor; DESIGN.md section 2). It maps the frame's rotation variation:
+    /// weighted inertia tensor; docs/formulation.md, "The internal force"). It maps the frame's rotation variation:
     /// `H δθ = −Σ w_i X̄_i × Rᵀ δx_i` (body-frame `δθ`).
     pub fn rotation_sensitivity(&self, frame: &Frame, x: &[f64]) -> Matrix3<f64> {
         let mut h = Matrix3::zeros();

@@ -1,4 +1,4 @@
-//! Node sets of supports and interfaces (DESIGN.md section 4): an RBE3-like distribution of a
+//! Node sets of supports and interfaces (docs/fmu.md): an RBE3-like distribution of a
 //! force and torque over the nodes, the weighted least-squares rigid motion of the nodes that is
 //! power-conjugate to it, and the resultant of nodal loads about the reference point.
 

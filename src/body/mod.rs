@@ -1,4 +1,4 @@
-//! The ACF-RS body (DESIGN.md section 2): constant mass `M = Ms ⊗ I3`, constant small-strain
+//! The ACF-RS body (docs/formulation.md): constant mass `M = Ms ⊗ I3`, constant small-strain
 //! stiffness `K`, the co-moving frame, the local deformation `ū`, the internal force with the
 //! nonlinear term `f_nl`, Rayleigh damping of the deformation, and the node sets of interfaces.
 
@@ -26,7 +26,7 @@ use nalgebra::{Matrix3, Vector3};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyOptions {
     /// Include `f_nl` (exact gradient of the strain energy; momentum-conserving). Default off:
-    /// DESIGN.md section 2 keeps it off until the benchmark table says otherwise.
+    /// docs/fmu.md, "Which terms a scene needs", says when a scene needs it.
     pub nonlinear_forces: bool,
     /// Mass-proportional Rayleigh coefficient `α` (1/s).
     pub damping_alpha: f64,
@@ -298,7 +298,7 @@ impl Body {
 
     /// The internal force `f = f_int + f_d` at positions `x` and velocities `v` (flat `3N`, N):
     ///
-    /// * local deformation `ū_i = Rᵀ(x_i − c) − X̄_i` (DESIGN.md section 2);
+    /// * local deformation `ū_i = Rᵀ(x_i − c) − X̄_i` (docs/formulation.md, "The local deformation");
     /// * `g = K ū`, elastic force `R g_i` (= `hR K hRᵀ (x − x_r)`, seed paper eq. 9);
     /// * if `nonlinear_forces`: `f_nl,i = −w_i R (X̄_i × z)`, `z = H⁻ᵀ m̄`, `m̄ = Σ ū_i × g_i`,
     ///   `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×`: with it `f_int` is the exact gradient of
@@ -307,7 +307,7 @@ impl Body {
     ///   `v_r` the rigid part of `ẋ` (see [`Body::rigid_velocity`]): zero for any rigid motion.
     ///
     /// `geometric_stiffness`, when given, adds the stiffening force `f_stiff = hR K_G ū`
-    /// (DESIGN.md section 2) with `K_G` of the current prestress.
+    /// (docs/formulation.md, "Geometric stiffening") with `K_G` of the current prestress.
     pub fn internal_force(
         &self,
         x: &[f64],

@@ -1,5 +1,5 @@
 //! Several co-moving frames: the elements split into patches, each with its own best-fit frame
-//! and its own constant stiffness (`model.frames`, DESIGN.md section 2 generalised).
+//! and its own constant stiffness (`model.frames`, docs/formulation.md, "Several co-moving frames").
 //!
 //! One frame per body measures the strain of a part that bends far against a frame that fits
 //! the whole part: where a beam section turns by `θ` relative to the body frame, the linear
@@ -12,7 +12,7 @@
 //! with `(c_p, R_p)` the best-fit frame of the patch's nodes (weights: the nodes' HRZ-lumped
 //! masses), `K_p` the small-strain stiffness of the patch's elements (`Σ_p K_p = K`) and
 //! `X̄_p,i` the reference offsets from the patch's weighted centroid. Its exact gradient is the
-//! single-frame force applied patch by patch (DESIGN.md section 2, eq. "f_int" and "f_nl"):
+//! single-frame force applied patch by patch (docs/formulation.md, "The internal force"):
 //!
 //! `f_i = Σ_{p ∋ i} R_p (g_p,i − w_i X̄_p,i × z_p)`, `g_p = K_p ū_p`, `z_p = H_p⁻ᵀ Σ_i ū_p,i × g_p,i`.
 //!

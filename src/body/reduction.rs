@@ -1,4 +1,4 @@
-//! Component mode synthesis in absolute coordinates (`model.modes = n`, DESIGN.md section 2,
+//! Component mode synthesis in absolute coordinates (`model.modes = n`, docs/formulation.md, "The reduced body",
 //! "Reduced body").
 //!
 //! The positions of the `N` nodes are restricted to `x_i = Σ_k S_ik q_k`, `k = 1..s`: `s` scalar

@@ -1,4 +1,4 @@
-//! Geometric stiffening of the reduced-strain body (DESIGN.md section 2):
+//! Geometric stiffening of the reduced-strain body (docs/formulation.md, "Geometric stiffening"):
 //! `f_stiff = hR K_G(S0) ū` with the prestress `S0` either
 //!
 //! * `inertial`: the static stress of the co-moving frame's rigid acceleration field

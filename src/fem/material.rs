@@ -14,7 +14,7 @@ pub struct IsotropicMaterial {
 }
 
 impl IsotropicMaterial {
-    /// Structural steel as in the benchmarks (BENCHMARKS.md, B1): E = 2.1e11 Pa, ν = 0.3,
+    /// Structural steel as in the benchmarks (docs/benchmarks.md, B1): E = 2.1e11 Pa, ν = 0.3,
     /// ρ = 7850 kg/m³.
     pub const STEEL: IsotropicMaterial = IsotropicMaterial {
         youngs_modulus: 2.1e11,

@@ -1,5 +1,5 @@
 //! The total-Lagrangian St. Venant–Kirchhoff solid: the `full` reference formulation
-//! (DESIGN.md section 2) on the same meshes, quadrature and DOF numbering (`3 * node + direction`)
+//! (docs/formulation.md, "The full formulation") on the same meshes, quadrature and DOF numbering (`3 * node + direction`)
 //! as the linear matrices of [`super::assembly`].
 //!
 //! With reference positions `X`, current positions `x = X + u` (m), the displacement gradient

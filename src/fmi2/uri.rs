@@ -1,6 +1,6 @@
 //! `fmuResourceLocation` → a local directory.
 //!
-//! Importers spell the same directory in several ways (FMI-IMPORTERS.md): fmpy and fmuCheck pass
+//! Importers spell the same directory in several ways (docs/fmu.md, "What the importers do"): fmpy and fmuCheck pass
 //! `file:///tmp/x%20y` (percent-encoded), OMSimulator (fmi4c) passes `file:////tmp/x y` (four
 //! slashes, not encoded), others `file:/tmp/x` or `file://localhost/tmp/x`. All of them are
 //! accepted here; so is a bare absolute path, which some tools pass although it is not a URI.

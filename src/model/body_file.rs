@@ -1,5 +1,5 @@
-//! The body file (`resources/body.json`, DESIGN.md section 5): mesh, material defaults,
-//! interfaces, damping, gravity and solver defaults. The default body (B1 of BENCHMARKS.md: a
+//! The body file (`resources/body.json`, docs/fmu.md, "The body file"): mesh, material defaults,
+//! interfaces, damping, gravity and solver defaults. The default body (B1 of docs/benchmarks.md: a
 //! clamped steel cantilever with a force interface `tip`) is embedded in the binary.
 
 use crate::error::{Error, Result};
@@ -143,7 +143,7 @@ pub struct DampingSpec {
     pub beta: f64,
 }
 
-/// What an interface does (DESIGN.md section 4).
+/// What an interface does (docs/fmu.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase")]
 pub enum InterfaceKind {
@@ -239,7 +239,7 @@ impl Default for SolverSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase", deny_unknown_fields)]
 pub struct ModelSpec {
-    /// Include the nonlinear internal force `f_nl` (DESIGN.md section 2). Off by default.
+    /// Include the nonlinear internal force `f_nl` (docs/formulation.md, "The internal force"). Off by default.
     #[serde(default)]
     pub nonlinear_forces: bool,
     /// Co-moving frames (`model.frames`, see `body::patches`): 1 (the default) is one frame for

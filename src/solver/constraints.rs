@@ -4,7 +4,7 @@
 //! `c_p(x) = Σ_i ŵ_i x_i − d_p = 0` with `ŵ_i = w_i / Σ w`. Stacked, `C x = d` with a constant
 //! Jacobian `C = (ŵ ⊗ I3)` per constraint, which commutes with the block rotation:
 //! `C hR = hR_c C` (`hR_c = diag(R, …)` on the constraint rows). With `S = hR S̄ hRᵀ` the Schur
-//! complement is therefore constant in the co-moving frame (DESIGN.md section 3):
+//! complement is therefore constant in the co-moving frame (docs/formulation.md, "One factorization per step size"):
 //!
 //! ```text
 //! C S⁻¹ Cᵀ = hR_c Ā hR_cᵀ,   Ā = C Z,   Z = S̄⁻¹ Cᵀ   (3m columns, one solve each, once per h)

@@ -1,6 +1,6 @@
 //! Generalized-α time integration (Chung & Hulbert 1993, in the form of Arnold & Brüls 2007) of
-//! `M ẍ + f(x, ẋ) = f_ext(x)` on the free DOFs, with the constant iteration matrix of DESIGN.md
-//! section 3: `S = hR S̄ hRᵀ`, `S̄ = c_m M + c_d D + K`, factorised once per step size.
+//! `M ẍ + f(x, ẋ) = f_ext(x)` on the free DOFs, with the constant iteration matrix of docs/formulation.md
+//! ("One factorization per step size"): `S = hR S̄ hRᵀ`, `S̄ = c_m M + c_d D + K`, factorised once per step size.
 //!
 //! Per step, with the pseudo-acceleration `a` (Arnold & Brüls):
 //!

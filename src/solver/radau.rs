@@ -12,7 +12,7 @@
 //! ```
 //!
 //! and, since `c_3 = 1` (stiffly accurate), `x_{n+1} = X_3`, `ẋ_{n+1} = V_3`, `ẍ_{n+1} = Ẍ_3`.
-//! Simplified Newton on `Z` with the constant matrix of DESIGN.md section 3
+//! Simplified Newton on `Z` with the constant matrix of docs/formulation.md, "One factorization per step size"
 //! (`∂f/∂x ≈ hR K hRᵀ`, `∂f/∂ẋ ≈ hR D hRᵀ`, `D = α M + β K` the Rayleigh damping):
 //!
 //! `J ≈ diag(R_s) (h⁻² A⁻² ⊗ M + h⁻¹ A⁻¹ ⊗ D + I ⊗ K) diag(R_s)ᵀ`, `R_s` the co-moving frame of

@@ -1,5 +1,5 @@
 //! The rank-3 (Woodbury) correction of the constant iteration matrix for the nonlinear force
-//! `f_nl` (DESIGN.md sections 2–3, issue 4).
+//! `f_nl` (docs/formulation.md, "The fixed-point iteration").
 //!
 //! In the co-moving frame `f̄_nl = B z` with the constant `B_i = −w_i [X̄_i]×` (3N × 3) and
 //! `z = H⁻ᵀ m̄`, `m̄ = Σ ū_i × g_i`, `g = K ū`. Its Jacobian with respect to the local

@@ -1,4 +1,4 @@
-//! The hub schedule of B3 (BENCHMARKS.md) and a driver of a B3 slave: shared by the B3 tests
+//! The hub schedule of B3 (docs/benchmarks.md) and a driver of a B3 slave: shared by the B3 tests
 //! and examples.
 #![allow(dead_code)]
 

@@ -7,7 +7,7 @@ use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
-/// Timoshenko tip deflection of B1 under 10 N (BENCHMARKS.md), m.
+/// Timoshenko tip deflection of B1 under 10 N (docs/benchmarks.md), m.
 pub const B1_TIMOSHENKO_DEFLECTION: f64 = 1.19084e-3;
 /// First bending frequency of B1 (Euler–Bernoulli), Hz.
 pub const B1_FIRST_FREQUENCY: f64 = 16.710;

@@ -3,7 +3,7 @@ package pinned in tests/python/requirements.txt:
 
     python tests/data/make_meshes.py          # from the repository root, in the venv
 
-* b1_tet10.msh: BENCHMARKS.md B1's cantilever (1 m x 20 mm x 20 mm), 10-node tetrahedra of size
+* b1_tet10.msh: docs/benchmarks.md B1's cantilever (1 m x 20 mm x 20 mm), 10-node tetrahedra of size
   10 mm, physical surfaces `root` (x = 0) and `tip` (x = 1 m), volume `solid`. ASCII.
 * quarter_ring_tet10.msh / .bin.msh: a quarter of a thick ring (radii 0.3 and 0.5 m, 0.2 m
   high), tet10 with the mid-edge nodes on the curved surfaces (curved elements), surfaces

@@ -4,7 +4,7 @@ state save/restore and independent instances.
 B1: steel beam 1 m x 20 mm x 20 mm (E = 210 GPa, nu = 0.3, rho = 7850 kg/m3), clamped at x = 0,
 load at the tip. Timoshenko beam theory gives the static tip deflection under 10 N as
 1.19084e-3 m (Euler-Bernoulli F L^3 / 3EI = 1.19048e-3 m plus shear); the hex20 mesh of the default
-body reproduces it within 1 % (BENCHMARKS.md).
+body reproduces it within 1 % (docs/benchmarks.md).
 """
 
 import math

@@ -1,4 +1,4 @@
-"""Each importer's habits (FMI-IMPORTERS.md), replayed through fmpy's low-level FMU2Slave the way
+"""Each importer's habits (docs/fmu.md, "What the importers do"), replayed through fmpy's low-level FMU2Slave the way
 that importer calls the FMU: OMSimulator (four-slash resource URI, visible and logging on, start
 values before setupExperiment, no stop time, every status must be exactly fmi2OK, time accumulated
 as t += h, a tiny last step), the FMU Compliance Checker (inputs before setupExperiment, no

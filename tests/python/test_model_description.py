@@ -1,5 +1,5 @@
 """The packaged FMU as an importer sees it before running it: archive layout, fmpy's validation,
-the variables of DESIGN.md section 4 with their units, and the declared capabilities."""
+the variables of docs/fmu.md with their units, and the declared capabilities."""
 
 import json
 import zipfile
@@ -56,7 +56,7 @@ def vector(name, n):
     return [f"{name}[{k}]" for k in range(1, n + 1)]
 
 
-# DESIGN.md section 4 for the default body: force interface `tip`, fixed support `root`.
+# docs/fmu.md, "Variables", for the default body: force interface `tip`, fixed support `root`.
 TIP_INPUTS = vector("tip.force", 3) + vector("tip.torque", 3)
 TIP_OUTPUTS = (
     vector("tip.position", 3)
