@@ -14,6 +14,7 @@
 //! `O(nnz(L))`. The least squares fit uses the first `fit` entries of `g` only (the positions,
 //! in metres), the mixing applies to all entries (positions and multipliers alike).
 
+use crate::linalg::dot;
 use nalgebra::{SMatrix, SVector};
 
 /// The largest history depth (the small least-squares system lives on the stack).
@@ -139,10 +140,6 @@ impl Anderson {
         self.stored = 0;
         self.next = 0;
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 #[cfg(test)]
