@@ -62,6 +62,11 @@ struct Var {
     min: Option<f64>,
     #[serde(default)]
     max: Option<f64>,
+    /// `min` (`max`) itself is not allowed: the range is open at that end.
+    #[serde(default, rename = "minExclusive")]
+    min_exclusive: bool,
+    #[serde(default, rename = "maxExclusive")]
+    max_exclusive: bool,
     description: String,
 }
 
@@ -121,12 +126,14 @@ fn main() {
             assert!(names.insert(name.clone()), "duplicate name {name}");
             writeln!(
                 table,
-                "    FixedVariableSpec {{ name: {name:?}, key: FixedKey::{key}, component: {k}, value_reference: {vr}, ty: VariableType::{ty}, causality: Causality::{causality}, variability: Variability::{variability}, unit: {unit}, declared_type: {declared}, min: {min}, max: {max}, description: {desc:?} }},",
+                "    FixedVariableSpec {{ name: {name:?}, key: FixedKey::{key}, component: {k}, value_reference: {vr}, ty: VariableType::{ty}, causality: Causality::{causality}, variability: Variability::{variability}, unit: {unit}, declared_type: {declared}, min: {min}, max: {max}, min_exclusive: {min_exclusive}, max_exclusive: {max_exclusive}, description: {desc:?} }},",
                 key = v.key,
                 unit = match &v.unit { Some(u) => format!("Some({u:?})"), None => "None".into() },
                 declared = match &v.declared_type { Some(u) => format!("Some({u:?})"), None => "None".into() },
                 min = opt_f64(v.min),
                 max = opt_f64(v.max),
+                min_exclusive = v.min_exclusive,
+                max_exclusive = v.max_exclusive,
                 desc = v.description,
             )
             .unwrap();

@@ -47,6 +47,9 @@ pub struct FixedVariableSpec {
     pub declared_type: Option<&'static str>,
     pub min: Option<f64>,
     pub max: Option<f64>,
+    /// `min` (`max`) itself is outside the range: the range is open at that end.
+    pub min_exclusive: bool,
+    pub max_exclusive: bool,
     pub description: &'static str,
 }
 
@@ -199,8 +202,57 @@ pub struct Variable {
     pub declared_type: Option<&'static str>,
     pub min: Option<f64>,
     pub max: Option<f64>,
+    /// The range is open at `min` (`max`).
+    pub min_exclusive: bool,
+    pub max_exclusive: bool,
     pub description: String,
     pub target: Target,
+}
+
+impl Variable {
+    /// Why `x` is outside the variable's range (`min`, `max`, open or closed at each end), if
+    /// it is: "must be positive", "must lie in (-1, 0.5)", ...
+    pub fn range_violation(&self, x: f64) -> Option<String> {
+        range_violation(
+            self.min,
+            self.max,
+            self.min_exclusive,
+            self.max_exclusive,
+            x,
+        )
+    }
+}
+
+/// Why `x` is outside the range from `min` to `max` (each optional, open at an exclusive end), if
+/// it is; the wording of every range error of the FMU.
+pub fn range_violation(
+    min: Option<f64>,
+    max: Option<f64>,
+    min_exclusive: bool,
+    max_exclusive: bool,
+    x: f64,
+) -> Option<String> {
+    let above = |lo: f64| if min_exclusive { x > lo } else { x >= lo };
+    let below = |hi: f64| if max_exclusive { x < hi } else { x <= hi };
+    match (min, max) {
+        (Some(lo), Some(hi)) if !(above(lo) && below(hi)) => Some(format!(
+            "must lie in {}{lo}, {hi}{}",
+            if min_exclusive { "(" } else { "[" },
+            if max_exclusive { ")" } else { "]" }
+        )),
+        (Some(lo), None) if !above(lo) => Some(match (lo == 0.0, min_exclusive) {
+            (true, true) => "must be positive".to_string(),
+            (true, false) => "must not be negative".to_string(),
+            (false, true) => format!("must be greater than {lo}"),
+            (false, false) => format!("must be at least {lo}"),
+        }),
+        (None, Some(hi)) if !below(hi) => Some(if max_exclusive {
+            format!("must be less than {hi}")
+        } else {
+            format!("must be at most {hi}")
+        }),
+        _ => None,
+    }
 }
 
 /// All variables of one FMU, in modelDescription order, with lookup by (type, value reference).
@@ -225,6 +277,8 @@ impl VariableTable {
                 declared_type: s.declared_type,
                 min: s.min,
                 max: s.max,
+                min_exclusive: s.min_exclusive,
+                max_exclusive: s.max_exclusive,
                 description: s.description.to_string(),
                 target: Target::Fixed {
                     key: s.key,
@@ -246,6 +300,8 @@ impl VariableTable {
                         declared_type: None,
                         min: None,
                         max: None,
+                        min_exclusive: false,
+                        max_exclusive: false,
                         description: quantity.description(spec.kind).to_string(),
                         target: Target::Interface {
                             index,
@@ -314,5 +370,43 @@ pub fn interface_variables(kind: InterfaceKind) -> &'static [(InterfaceQuantity,
             (Force, Output),
             (Torque, Output),
         ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::range_violation;
+
+    #[test]
+    fn range_errors_name_the_range_with_its_open_and_closed_ends() {
+        let r = |min, max, lo_open, hi_open, x| range_violation(min, max, lo_open, hi_open, x);
+        assert_eq!(
+            r(Some(0.0), None, true, false, 0.0).unwrap(),
+            "must be positive"
+        );
+        assert_eq!(
+            r(Some(0.0), None, false, false, -1e-300).unwrap(),
+            "must not be negative"
+        );
+        assert_eq!(r(Some(0.0), None, false, false, 0.0), None);
+        assert_eq!(
+            r(Some(1.0), None, false, false, 0.0).unwrap(),
+            "must be at least 1"
+        );
+        assert_eq!(
+            r(Some(-1.0), Some(0.5), true, true, 0.5).unwrap(),
+            "must lie in (-1, 0.5)"
+        );
+        assert_eq!(r(Some(-1.0), Some(0.5), true, true, 0.49), None);
+        assert_eq!(r(Some(0.0), Some(1.0), false, false, 1.0), None);
+        assert_eq!(
+            r(Some(0.0), Some(8.0), false, false, 9.0).unwrap(),
+            "must lie in [0, 8]"
+        );
+        assert_eq!(
+            r(None, Some(2.0), false, true, 2.0).unwrap(),
+            "must be less than 2"
+        );
+        assert_eq!(r(None, None, false, false, f64::MAX), None);
     }
 }

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
-use crate::model::variables::FixedKey;
+use crate::model::variables::{range_violation, FixedKey, FIXED_VARIABLES};
 use crate::model::{BodyFile, Target};
 use crate::solver::anderson::MAX_DEPTH;
 
@@ -101,23 +101,22 @@ impl Parameters {
         if !value.is_finite() {
             return Err(Error::invalid_value(name, value, "not a finite number"));
         }
-        let reason = match key {
-            FixedKey::YoungsModulus if value <= 0.0 => Some("must be positive"),
-            FixedKey::Density if value <= 0.0 => Some("must be positive"),
-            FixedKey::PoissonRatio if !(value > -1.0 && value < 0.5) => {
-                Some("must lie in (-1, 0.5): 0.5 is incompressible, which a displacement formulation cannot represent")
-            }
-            FixedKey::DampingAlpha | FixedKey::DampingBeta if value < 0.0 => {
-                Some("must not be negative (negative damping adds energy)")
-            }
-            FixedKey::StepSize if value <= 0.0 => Some("must be positive"),
-            FixedKey::RhoInf if !(0.0..=1.0).contains(&value) => Some("must lie in [0, 1]"),
-            FixedKey::Tolerance if !(value > 0.0 && value < 1.0) => Some("must lie in (0, 1)"),
-            FixedKey::OutputInterval if value < 0.0 => Some("must not be negative"),
-            _ => None,
-        };
+        // The range of variables.json; a note on why for the ranges a user may wonder about.
+        let reason = FIXED_VARIABLES
+            .iter()
+            .find(|s| s.key == key)
+            .and_then(|s| range_violation(s.min, s.max, s.min_exclusive, s.max_exclusive, value))
+            .map(|r| match key {
+                FixedKey::PoissonRatio => format!(
+                    "{r}: 0.5 is incompressible, which a displacement formulation cannot represent"
+                ),
+                FixedKey::DampingAlpha | FixedKey::DampingBeta => {
+                    format!("{r} (negative damping adds energy)")
+                }
+                _ => r,
+            });
         match reason {
-            Some(r) => Err(Error::invalid_value(name, value, r)),
+            Some(r) => Err(Error::invalid_value(name, value, &r)),
             None => Ok(()),
         }
     }

@@ -247,15 +247,7 @@ impl Slave {
                 ));
             }
         }
-        let x = f64::from(value);
-        let reason = match (v.min, v.max) {
-            (Some(lo), Some(hi)) if !(lo..=hi).contains(&x) => {
-                Some(format!("must lie in [{lo}, {hi}]"))
-            }
-            (Some(lo), None) if x < lo && lo == 0.0 => Some("must not be negative".to_string()),
-            (Some(lo), None) if x < lo => Some(format!("must be at least {lo}")),
-            _ => None,
-        };
+        let reason = v.range_violation(f64::from(value));
         let elements = self.mesh.element_count();
         let frames = matches!(
             v.target,
