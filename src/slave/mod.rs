@@ -36,6 +36,7 @@ pub use crate::solver::integrator::MATRIX_CACHE_SIZE;
 pub use assembly::Features;
 pub use cosim::CoSimSlave;
 pub use parameters::Parameters;
+pub(crate) use state_bytes::Reader as StateReader;
 pub use state_bytes::PAYLOAD_FORMAT as STATE_PAYLOAD_FORMAT;
 pub use stepping::MAX_STEP_HALVINGS;
 

@@ -54,12 +54,37 @@ impl Writer<'_> {
     }
 }
 
-struct Reader<'a> {
+/// Reads little-endian numbers of a serialized FMU state; every error names what it was reading
+/// and where (the FMI layer reads its header with it too).
+pub(crate) struct Reader<'a> {
     bytes: &'a [u8],
     at: usize,
 }
 
-impl Reader<'_> {
+impl<'a> Reader<'a> {
+    pub(crate) fn new(bytes: &'a [u8]) -> Reader<'a> {
+        Reader { bytes, at: 0 }
+    }
+
+    /// The next `n` bytes.
+    pub(crate) fn bytes(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
+        let end = self.at.checked_add(n).filter(|&end| end <= self.bytes.len()).ok_or_else(|| {
+            Error::new(format!(
+                "the serialized FMU state is truncated: {} bytes, {what} needs {n} bytes from byte {}",
+                self.bytes.len(),
+                self.at
+            ))
+        })?;
+        let chunk = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(chunk)
+    }
+
+    /// The bytes not read yet.
+    pub(crate) fn rest(&self) -> &'a [u8] {
+        &self.bytes[self.at..]
+    }
+
     fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
         let end = self.at + N;
         let chunk = self.bytes.get(self.at..end).ok_or_else(|| {
@@ -89,10 +114,10 @@ impl Reader<'_> {
         }
         Ok(())
     }
-    fn u64(&mut self, what: &str) -> Result<u64> {
+    pub(crate) fn u64(&mut self, what: &str) -> Result<u64> {
         Ok(u64::from_le_bytes(self.take::<8>(what)?))
     }
-    fn u32(&mut self, what: &str) -> Result<u32> {
+    pub(crate) fn u32(&mut self, what: &str) -> Result<u32> {
         Ok(u32::from_le_bytes(self.take::<4>(what)?))
     }
     fn i32(&mut self, what: &str) -> Result<i32> {
@@ -107,7 +132,7 @@ impl Reader<'_> {
             ))
         })
     }
-    fn u8(&mut self, what: &str) -> Result<u8> {
+    pub(crate) fn u8(&mut self, what: &str) -> Result<u8> {
         Ok(self.take::<1>(what)?[0])
     }
     /// A count that must equal `expected` (a property of this body).
@@ -187,7 +212,7 @@ impl Slave {
     /// Reads a payload written by [`SlaveState::write_bytes`] for this body; every count, number
     /// and parameter is checked (see the module documentation).
     pub fn state_from_bytes(&self, bytes: &[u8]) -> Result<SlaveState> {
-        let mut r = Reader { bytes, at: 0 };
+        let mut r = Reader::new(bytes);
         let format = r.u32("the payload format")?;
         if format != PAYLOAD_FORMAT {
             return Err(Error::new(format!(

@@ -3,6 +3,7 @@
 
 use super::{CoSimSlave, Instance, MachineState, ANY_BUT_FATAL, M};
 use crate::fmi2::types::fmi2Status;
+use crate::slave::StateReader;
 
 /// Identifies a [`Snapshot`] made by this crate (a cheap guard against foreign pointers).
 pub(super) const SNAPSHOT_MAGIC: u64 = 0x666c_6578_6d75_7374; // "flexmust"
@@ -118,50 +119,34 @@ impl<S: CoSimSlave> Instance<S> {
     }
 
     fn parse_snapshot(&self, bytes: &[u8]) -> std::result::Result<Snapshot<S::State>, String> {
-        let truncated = || {
-            format!(
-                "the serialized FMU state is truncated ({} bytes) or not one of this FMU",
-                bytes.len()
-            )
-        };
         if bytes.len() < SERIALIZED_MAGIC.len() || &bytes[..8] != SERIALIZED_MAGIC {
             return Err(format!(
                 "the {} bytes are not a serialized state of this FMU (they do not start with \"FLEXBODY\")",
                 bytes.len()
             ));
         }
-        let u32_at = |at: usize| {
-            bytes
-                .get(at..at + 4)
-                .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
-        };
-        let format = u32_at(8).ok_or_else(truncated)?;
+        let message = |e: crate::Error| e.message;
+        let mut r = StateReader::new(&bytes[SERIALIZED_MAGIC.len()..]);
+        let format = r.u32("the format version").map_err(message)?;
         if format != SERIALIZED_FORMAT {
             return Err(format!(
                 "the serialized FMU state has format version {format}; this FMU reads version {SERIALIZED_FORMAT} (it was written by another version of flexbody)"
             ));
         }
-        let guid_len = u32_at(12).ok_or_else(truncated)? as usize;
-        let guid_end = 16usize.checked_add(guid_len).ok_or_else(truncated)?;
-        let guid = bytes.get(16..guid_end).ok_or_else(truncated)?;
-        let guid = String::from_utf8_lossy(guid).into_owned();
+        let guid_len = r.u32("the GUID's length").map_err(message)? as usize;
+        let guid =
+            String::from_utf8_lossy(r.bytes(guid_len, "the GUID").map_err(message)?).into_owned();
         if guid != self.slave.guid() {
             return Err(format!(
                 "the serialized FMU state belongs to an FMU with GUID {guid}; this instance has GUID {} (another body, body file or version of flexbody)",
                 self.slave.guid()
             ));
         }
-        let rest = &bytes[guid_end..];
-        if rest.len() < 10 {
-            return Err(truncated());
-        }
-        let machine = machine_state_from_code(rest[0]).ok_or_else(|| {
-            format!(
-                "the serialized FMU state has an unknown calling-sequence state {}",
-                rest[0]
-            )
+        let code = r.u8("the calling-sequence state").map_err(message)?;
+        let machine = machine_state_from_code(code).ok_or_else(|| {
+            format!("the serialized FMU state has an unknown calling-sequence state {code}")
         })?;
-        let terminate_requested = match rest[1] {
+        let terminate_requested = match r.u8("the termination flag").map_err(message)? {
             0 => false,
             1 => true,
             b => {
@@ -170,22 +155,18 @@ impl<S: CoSimSlave> Instance<S> {
                 ))
             }
         };
-        let len = u64::from_le_bytes(rest[2..10].try_into().unwrap());
-        let payload_end = usize::try_from(len)
-            .ok()
-            .and_then(|l| l.checked_add(10))
-            .filter(|&end| end <= rest.len())
-            .ok_or_else(truncated)?;
-        if rest[payload_end..].iter().any(|&b| b != 0) {
+        let len = r.u64("the payload length").map_err(message)?;
+        let len =
+            usize::try_from(len).map_err(|_| format!("the payload length {len} is too large"))?;
+        let payload = r.bytes(len, "the payload").map_err(message)?;
+        // An importer may pass a larger buffer: what follows the payload must be zero.
+        if r.rest().iter().any(|&b| b != 0) {
             return Err(format!(
                 "the serialized FMU state is followed by {} bytes that are not zero",
-                rest.len() - payload_end
+                r.rest().len()
             ));
         }
-        let slave = self
-            .slave
-            .state_from_bytes(&rest[10..payload_end])
-            .map_err(|e| e.message)?;
+        let slave = self.slave.state_from_bytes(payload).map_err(message)?;
         Ok(Snapshot {
             magic: SNAPSHOT_MAGIC,
             guid,
