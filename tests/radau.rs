@@ -102,6 +102,7 @@ fn run_from(
     let settings = IterationSettings {
         absolute_tolerance: 1e-15,
         max_iterations: 50,
+        estimate_error: None,
     };
     let mut tip = Vec::new();
     let steps = (end / h).round() as usize;

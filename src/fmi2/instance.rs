@@ -297,6 +297,8 @@ impl<S: CoSimSlave> Instance<S> {
             return s;
         }
         self.state = M::Terminated;
+        self.slave.terminate();
+        self.flush_events();
         self.logger
             .event(&format!("{F}: terminated at t = {}", self.slave.time()));
         fmi2Status::fmi2OK

@@ -255,6 +255,11 @@ pub struct ModelSpec {
     /// switched on per step only when it changes the result beyond the solver tolerance.
     #[serde(default = "ModelSpec::default_auto")]
     pub auto: bool,
+    /// `model.accuracy`: the accepted error relative to the deformation scale, which sets the
+    /// internal step (docs/formulation.md, "Time error control"); 0 (the default): the fixed
+    /// step `solver.stepSize`.
+    #[serde(default = "ModelSpec::default_accuracy")]
+    pub accuracy: f64,
 }
 
 impl Default for ModelSpec {
@@ -264,6 +269,7 @@ impl Default for ModelSpec {
             frames: ModelSpec::default_frames(),
             modes: 0,
             auto: ModelSpec::default_auto(),
+            accuracy: ModelSpec::default_accuracy(),
         }
     }
 }
@@ -274,6 +280,9 @@ impl ModelSpec {
     }
     fn default_auto() -> bool {
         true
+    }
+    fn default_accuracy() -> f64 {
+        0.0
     }
 }
 

@@ -55,6 +55,11 @@ pub(super) struct Model {
     /// `K_G` while stiffening is switched off (it moves to `forces.geometric_stiffness` and
     /// back: no allocation).
     pub(super) parked_geometric_stiffness: Option<crate::linalg::SymmetricCsr>,
+    /// `T₁ = 2π/ω₁` (s), the period of the lowest natural frequency of the body on its
+    /// supports (of its lowest elastic mode if it has none): the time over which the error
+    /// control lets the errors add up to `model.accuracy` (`slave::step_control`). `None`
+    /// without error control.
+    pub(super) first_period: Option<f64>,
 }
 
 impl Model {
@@ -348,6 +353,19 @@ impl Slave {
         });
         let integrator = self.time_integrator(&body, lumped, &free)?;
         let p = &self.parameters;
+        let first_period = (p.accuracy > 0.0 && p.integrator == Integrator::GeneralizedAlpha)
+            .then(|| lowest_period(&free, indicators.as_ref()))
+            .transpose()?;
+        if let Some(t1) = first_period {
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "model.accuracy = {:e}: the internal step is chosen from solver.stepSize / 2^k (k ≤ {}) so that the estimated error over one period of the lowest mode, T₁ = {t1:.4e} s, stays below model.accuracy × the deformation scale",
+                    p.accuracy,
+                    super::step_control::MAX_LEVEL
+                ),
+            });
+        }
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {
@@ -362,6 +380,7 @@ impl Slave {
             indicators,
             allowed,
             parked_geometric_stiffness: None,
+            first_period,
         });
         self.dynamics = None;
         // The backups have the old model's size (a changed model.modes changes it).
@@ -369,6 +388,7 @@ impl Slave {
         self.retry_backup = None;
         let size = self.model.as_ref().map_or(0, |m| m.body.reference.len());
         self.outputs.momentum = vec![0.0; size];
+        self.scale_scratch = vec![0.0; size];
         Ok(())
     }
 
@@ -517,4 +537,50 @@ impl Slave {
         }
         Ok(())
     }
+}
+
+/// `T₁ = 2π/ω₁` (s) of the free DOFs' `K_FF`, `M_FF`: from `model.auto`'s modes if it has them,
+/// else by subspace iteration. A body without fixed supports or motion interfaces (pins and
+/// hinges included: the free body's frequency is the scale) has six rigid modes (`ω = 0`): it is
+/// computed on `K + σM` (`σ` far below the elastic `ω²`, which the shift moves by `σ`) and the
+/// seventh eigenvalue is taken.
+fn lowest_period(free: &FreeNodes, indicators: Option<&FeatureIndicators>) -> Result<f64> {
+    let omega = match indicators.and_then(FeatureIndicators::first_frequency) {
+        Some(w) => w,
+        None => {
+            let supported = !free.clamped.is_empty();
+            let (k, m) = (&free.stiffness, &free.mass);
+            let diagonal = |a: &SymmetricCsr, i: usize| {
+                (a.row_ptr[i]..a.row_ptr[i + 1])
+                    .find(|&j| a.col_idx[j] == i)
+                    .map_or(0.0, |j| a.values[j])
+            };
+            let (shift, index) = if supported {
+                (0.0, 0)
+            } else {
+                // The smallest diagonal ratio bounds ω₁² from above by far on a mesh; 1e-6 of it
+                // keeps K + σM well conditioned and moves ω₁² by a negligible amount.
+                let smallest = (0..k.n)
+                    .map(|i| diagonal(k, i) / diagonal(m, i).max(f64::MIN_POSITIVE))
+                    .fold(f64::INFINITY, f64::min);
+                (1e-6 * smallest, 6)
+            };
+            let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
+            let count = (index + 1).min(k.n);
+            let pairs =
+                fem::modal::lowest_eigenpairs(&shifted, m, count, 1e-6, 200).map_err(|e| {
+                    Error::new(format!(
+                        "model.accuracy: the lowest natural frequency: {}",
+                        e.message
+                    ))
+                })?;
+            (pairs.eigenvalues[count - 1] - shift).max(0.0).sqrt()
+        }
+    };
+    if !(omega.is_finite() && omega > 0.0) {
+        return Err(Error::new(format!(
+            "model.accuracy: the lowest natural frequency came out as {omega} rad/s; set model.accuracy = 0 for a fixed internal step"
+        )));
+    }
+    Ok(2.0 * std::f64::consts::PI / omega)
 }

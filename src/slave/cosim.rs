@@ -46,6 +46,8 @@ pub trait CoSimSlave {
         communication_step_size: f64,
     ) -> Result<()>;
     fn time(&self) -> f64;
+    /// `fmi2Terminate`: the slave may leave a summary of the run in its log (default: nothing).
+    fn terminate(&mut self) {}
     fn reset(&mut self);
     fn get_state(&self) -> Self::State;
     fn set_state(&mut self, state: &Self::State) -> Result<()>;
@@ -125,6 +127,9 @@ impl CoSimSlave for Slave {
     }
     fn time(&self) -> f64 {
         Slave::time(self)
+    }
+    fn terminate(&mut self) {
+        Slave::terminate(self)
     }
     fn reset(&mut self) {
         Slave::reset(self)

@@ -107,6 +107,8 @@ impl Slave {
             gravity: self.parameters.gravity,
             features,
             quiet_since: [NOT_QUIET; 2],
+            step_level: 0,
+            deformation_scale: 0.0,
         });
         self.outputs.valid = false;
         Ok(())

@@ -204,6 +204,20 @@ pub(super) fn apply_loads(
     }
 }
 
+/// Whether two driving frames differ beyond round-off (`1e-12` of the quantity, plus `1e-12`
+/// absolute).
+fn frames_differ(a: &DrivingFrame, b: &DrivingFrame) -> bool {
+    let far = |x: f64, y: f64| (x - y).abs() > 1e-12 * (1.0 + x.abs().max(y.abs()));
+    let pairs = a
+        .position
+        .iter()
+        .zip(b.position.iter())
+        .chain(a.rotation.iter().zip(b.rotation.iter()))
+        .chain(a.velocity.iter().zip(b.velocity.iter()))
+        .chain(a.angular_velocity.iter().zip(b.angular_velocity.iter()));
+    pairs.into_iter().any(|(&x, &y)| far(x, y))
+}
+
 /// A force interface's inputs `τ` seconds after their sample time: `u + u'·τ + u''·τ²/2`
 /// in the force and torque slots (the only ones with derivatives); the same arithmetic as
 /// [`apply_loads`], so the end-of-step loads match those the last internal step used.
@@ -219,20 +233,45 @@ impl Slave {
     /// The inputs' ages at the current time `t_0` (`t_0 − t_s` per interface) and the driving
     /// frames of the motion interfaces there: the frame of the inputs, extrapolated from their
     /// sample time `t_s` to `t_0` (no allocation unless an input is rejected).
-    pub(super) fn update_driving_frames(&mut self) -> Result<()> {
+    ///
+    /// Returns whether an input jumps at `t_0`: a motion interface's frame (pose or velocities)
+    /// differs from the previous step's frame carried on to `t_0`, or a force interface set at
+    /// `t_0` differs from the loads the state's accelerations belong to. The step after a jump
+    /// starts from a kink of the driving motion or the load, which no internal step can resolve
+    /// (the error control does not estimate its error, `slave::step_control`).
+    pub(super) fn update_driving_frames(&mut self) -> Result<bool> {
         let t = self.time();
+        let mut jumped = false;
+        let last = self.last_step_size;
         for (k, interface) in self.interfaces.iter().enumerate() {
             let age = t - self.input_times[k];
             self.input_ages[k] = age;
-            if interface.kind == InterfaceKind::Motion {
-                let mut frame = driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
-                if age != 0.0 {
-                    (frame.position, frame.rotation) = frame.at(age);
+            match interface.kind {
+                InterfaceKind::Motion => {
+                    let mut frame =
+                        driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
+                    if age != 0.0 {
+                        (frame.position, frame.rotation) = frame.at(age);
+                    }
+                    let old = self.driving[k];
+                    let (position, rotation) = old.at(last);
+                    let carried = DrivingFrame {
+                        position,
+                        rotation,
+                        ..old
+                    };
+                    jumped |= last > 0.0 && frames_differ(&carried, &frame);
+                    self.driving[k] = frame;
                 }
-                self.driving[k] = frame;
+                InterfaceKind::Force if age == 0.0 => {
+                    if let Some(d) = &self.dynamics {
+                        jumped |= self.inputs[k][..6] != d.loads[k][..6];
+                    }
+                }
+                _ => {}
             }
         }
-        Ok(())
+        Ok(jumped)
     }
 
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or

@@ -30,6 +30,7 @@ mod outputs;
 mod parameters;
 mod results;
 mod state_bytes;
+mod step_control;
 mod stepping;
 mod variables;
 pub use crate::solver::integrator::MATRIX_CACHE_SIZE;
@@ -71,6 +72,12 @@ struct Dynamics {
     /// Per term (f_nl, stiffening): since when its estimate has stayed below the switch-off
     /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
     quiet_since: [f64; 2],
+    /// The rung `k` of the internal step `solver.stepSize / 2^k` for the next communication
+    /// step ([`step_control`]).
+    step_level: u32,
+    /// The deformation scale `D` (m): the largest mass-weighted RMS elastic displacement seen so
+    /// far ([`step_control`]).
+    deformation_scale: f64,
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -86,8 +93,9 @@ pub struct SlaveState {
     last_step_size: f64,
     start_time: f64,
     dynamics: Option<Dynamics>,
-    /// Internal steps, fixed-point iterations, retried internal steps.
-    counters: [u64; 3],
+    /// Internal steps, fixed-point iterations, retried internal steps, rejected communication
+    /// steps.
+    counters: [u64; 4],
 }
 
 /// A message for the importer's logger that is not an error: `category` is one of the declared
@@ -143,6 +151,15 @@ pub struct Slave {
     statistics: (u64, u64),
     /// Internal steps that did not converge and were retried with halved steps.
     retries: u64,
+    /// Communication steps redone with finer internal steps because the error estimate exceeded
+    /// the accuracy ([`step_control`]).
+    rejected: u64,
+    /// The error control's scratch over the communication step under way: the largest ratio of
+    /// an internal step's error estimate to its allowance (`None`: no step was estimated),
+    /// whether an input jumped at its start, and `M ū` for the deformation scale.
+    step_error: Option<f64>,
+    inputs_jumped: bool,
+    scale_scratch: Vec<f64>,
     /// Messages for the logger, drained by the FMI layer after each call.
     events: Vec<LogEvent>,
     /// The VTK results of this run, if `output.directory` is set.
@@ -232,6 +249,10 @@ impl Slave {
             },
             statistics: (0, 0),
             retries: 0,
+            rejected: 0,
+            step_error: None,
+            inputs_jumped: false,
+            scale_scratch: Vec::new(),
             events: Vec::new(),
             results: None,
         })
@@ -383,6 +404,36 @@ impl Slave {
         self.retries
     }
 
+    /// Communication steps redone with finer internal steps because the estimated error
+    /// exceeded `model.accuracy`.
+    pub fn rejected_steps(&self) -> u64 {
+        self.rejected
+    }
+
+    /// The internal step the error control has chosen for the next communication step (s): the
+    /// rung `solver.stepSize / 2^k` (before the communication step divides it evenly).
+    pub fn controlled_step_size(&self) -> f64 {
+        let level = self.dynamics.as_ref().map_or(0, |d| d.step_level);
+        step_control::rung(self.parameters.step_size, level)
+    }
+
+    /// `fmi2Terminate`: the run's counters under `logEvents` (internal steps, iterations, retried
+    /// and rejected steps, the rung of the internal step).
+    pub fn terminate(&mut self) {
+        let (steps, iterations) = self.statistics;
+        self.events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "run summary: {steps} internal steps, {iterations} fixed-point iterations ({:.2} per step), {} internal steps retried with halved steps, {} communication steps redone on a finer rung by the error control (model.accuracy = {:e}); last internal step at most {:e} s",
+                iterations as f64 / steps.max(1) as f64,
+                self.retries,
+                self.rejected,
+                self.parameters.accuracy,
+                self.controlled_step_size()
+            ),
+        });
+    }
+
     /// `fmi2Reset`: back to the freshly instantiated state (parameters at their start values). The
     /// assembled matrices are kept for reuse if the parameters come back the same.
     pub fn reset(&mut self) {
@@ -398,6 +449,7 @@ impl Slave {
         self.backup = None;
         self.statistics = (0, 0);
         self.retries = 0;
+        self.rejected = 0;
         self.outputs.valid = false;
         self.results = None;
     }
@@ -412,7 +464,12 @@ impl Slave {
             last_step_size: self.last_step_size,
             start_time: self.start_time,
             dynamics: self.dynamics.clone(),
-            counters: [self.statistics.0, self.statistics.1, self.retries],
+            counters: [
+                self.statistics.0,
+                self.statistics.1,
+                self.retries,
+                self.rejected,
+            ],
         }
     }
 
@@ -432,6 +489,7 @@ impl Slave {
         self.start_time = state.start_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];
+        self.rejected = state.counters[3];
         if let Some(d) = &state.dynamics {
             self.ensure_model()?;
             let expected = 3 * self.model.as_ref().unwrap().body.node_count();
@@ -450,6 +508,8 @@ impl Slave {
                 d.gravity = s.gravity;
                 d.features = s.features;
                 d.quiet_since = s.quiet_since;
+                d.step_level = s.step_level;
+                d.deformation_scale = s.deformation_scale;
             }
             (d, s) => *d = s.clone(),
         }

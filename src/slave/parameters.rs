@@ -23,6 +23,9 @@ pub struct Parameters {
     pub step_size: f64,
     pub rho_inf: f64,
     pub tolerance: f64,
+    /// `model.accuracy`: the accepted error relative to the deformation scale (0: no time error
+    /// control, see `slave::step_control`).
+    pub accuracy: f64,
     pub max_iterations: i32,
     pub nonlinear_forces: bool,
     /// `model.auto`: with it `nonlinear_forces` and `stiffening` are what is allowed and the
@@ -64,6 +67,7 @@ impl Parameters {
             step_size: b.solver.step_size,
             rho_inf: b.solver.rho_inf,
             tolerance: b.solver.tolerance,
+            accuracy: b.model.accuracy,
             max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
             nonlinear_forces: b.model.nonlinear_forces,
             auto: b.model.auto,
@@ -203,6 +207,7 @@ macro_rules! parameter_slot {
             StepSize => Slot::Real(&$($m)? $p.step_size),
             RhoInf => Slot::Real(&$($m)? $p.rho_inf),
             Tolerance => Slot::Real(&$($m)? $p.tolerance),
+            Accuracy => Slot::Real(&$($m)? $p.accuracy),
             OutputInterval => Slot::Real(&$($m)? $p.output_interval),
             MaxIterations => Slot::Integer(&$($m)? $p.max_iterations),
             Formulation => Slot::Choice(&$($m)? $p.formulation),

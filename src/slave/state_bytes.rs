@@ -7,15 +7,15 @@
 //! | --- | --- |
 //! | payload format | u32 = [`PAYLOAD_FORMAT`] |
 //! | interfaces `n` | u32 |
-//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces, auto: u8 |
+//! | parameters | E, ν, ρ, α, β, gravity[3], initial position[3], rotation[9], velocity[3], angular velocity[3], step size, ρ∞, tolerance, accuracy: f64; max iterations, formulation, stiffening, frames, Anderson depth, integrator, modes: i32; nonlinear forces, auto: u8 |
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
-//! | counters | internal steps, iterations, retries: u64 |
+//! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening); since when their indicators are quiet [2] f64 (f64::MAX: not) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64 |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -29,7 +29,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 3;
+pub const PAYLOAD_FORMAT: u32 = 4;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -167,7 +167,7 @@ impl SlaveState {
         w.f64s(&p.initial_rotation);
         w.f64s(&p.initial_velocity);
         w.f64s(&p.initial_angular_velocity);
-        w.f64s(&[p.step_size, p.rho_inf, p.tolerance]);
+        w.f64s(&[p.step_size, p.rho_inf, p.tolerance, p.accuracy]);
         w.i32(p.max_iterations);
         w.i32(p.formulation.item());
         w.i32(p.stiffening.item());
@@ -203,6 +203,8 @@ impl SlaveState {
                 w.f64s(&d.gravity);
                 w.u8(u8::from(d.features.nonlinear_forces) | u8::from(d.features.stiffening) << 1);
                 w.f64s(&d.quiet_since);
+                w.u32(d.step_level);
+                w.f64(d.deformation_scale);
             }
         }
     }
@@ -244,6 +246,7 @@ impl Slave {
             r.u64("the step counter")?,
             r.u64("the iteration counter")?,
             r.u64("the retry counter")?,
+            r.u64("the rejected-step counter")?,
         ];
         let dynamics = self.read_dynamics(&mut r, &p, n)?;
         if r.at != bytes.len() {
@@ -282,9 +285,9 @@ impl Slave {
         r.f64s(&mut p.initial_rotation, "initial.rotation")?;
         r.f64s(&mut p.initial_velocity, "initial.velocity")?;
         r.f64s(&mut p.initial_angular_velocity, "initial.angularVelocity")?;
-        let mut solver = [0.0; 3];
+        let mut solver = [0.0; 4];
         r.f64s(&mut solver, "solver parameters")?;
-        [p.step_size, p.rho_inf, p.tolerance] = solver;
+        [p.step_size, p.rho_inf, p.tolerance, p.accuracy] = solver;
         p.max_iterations = r.i32("solver.maxIterations")?;
         p.formulation = r.choice("model.formulation", Formulation::from_item)?;
         p.stiffening = r.choice("model.stiffening", Stiffening::from_item)?;
@@ -376,6 +379,19 @@ impl Slave {
                     &mut quiet_since,
                     "the times since the terms' indicators are quiet",
                 )?;
+                let step_level = r.u32("the step level")?;
+                if step_level > super::step_control::MAX_LEVEL {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state holds step level {step_level}: more than {}",
+                        super::step_control::MAX_LEVEL
+                    )));
+                }
+                let deformation_scale = r.f64("the deformation scale")?;
+                if deformation_scale < 0.0 {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state holds a negative deformation scale {deformation_scale}"
+                    )));
+                }
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -390,6 +406,8 @@ impl Slave {
                     gravity,
                     features,
                     quiet_since,
+                    step_level,
+                    deformation_scale,
                 })
             }
             b => {
@@ -420,6 +438,7 @@ fn check_parameters(p: &Parameters) -> Result<()> {
         ("solver.stepSize", FixedKey::StepSize, p.step_size),
         ("solver.rhoInf", FixedKey::RhoInf, p.rho_inf),
         ("solver.tolerance", FixedKey::Tolerance, p.tolerance),
+        ("model.accuracy", FixedKey::Accuracy, p.accuracy),
     ] {
         Parameters::check_real(name, key, value)
             .map_err(|e| Error::new(format!("the serialized FMU state: {}", e.message)))?;

@@ -2,6 +2,7 @@
 
 use super::auto_features::choose_features;
 use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
+use super::step_control::{allowance, finer_level, rung, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL};
 use super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
@@ -27,31 +28,81 @@ impl Slave {
         communication_step_size: f64,
     ) -> Result<()> {
         let t_c = current_communication_point;
-        let (n, h) = self.internal_steps(t_c, communication_step_size)?;
+        self.check_step_request(t_c, communication_step_size)?;
         let big_h = self.snapped_step(communication_step_size);
         // The FMU's own clock, which agrees with the importer's to a few ulps: steps are timed
         // on it (not on `t_c`, which importers compute differently), so that the same inputs
         // give the same bits in every importer.
         let t0 = self.time();
-        self.prepare_step(h)?;
+        let controlled = self.error_controlled();
+        let mut level = self.dynamics.as_ref().unwrap().step_level;
+        self.inputs_jumped = self.update_driving_frames()?;
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
         // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
         // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
         // H = 2e-4 s). Input derivatives give continuous loads instead.
-        let mut result = Ok(());
-        for i in 0..n {
-            result = self.internal_step(t0, big_h, i, n, h);
-            if result.is_err() {
-                break;
+        let result = loop {
+            let (n, h) = self.internal_steps(big_h, level)?;
+            self.prepare_step(h)?;
+            // With one internal step after an input jump nothing is estimated (see
+            // `advance`): the deformation scale is not needed either.
+            if controlled && (n > 1 || !self.inputs_jumped) {
+                self.load_scale();
             }
-        }
+            self.step_error = None;
+            let mut result = Ok(());
+            for i in 0..n {
+                result = self.internal_step(t0, big_h, i, n, h);
+                let redo = self.step_error.is_some_and(|r| r > 1.0) && level < MAX_LEVEL;
+                if result.is_err() || redo {
+                    break;
+                }
+            }
+            let ratio = self.step_error.unwrap_or(0.0);
+            if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
+                // Redone from its start on a finer rung (docs/formulation.md, "Time error
+                // control").
+                let finer = finer_level(level, ratio);
+                self.rejected += 1;
+                self.events.push(LogEvent {
+                    category: category::EVENTS,
+                    message: format!(
+                        "model.accuracy: the step from t = {t0} by {big_h} estimated {ratio:.2} × its allowed error with internal steps of {h:e} s; redone with internal steps of at most {:e} s",
+                        rung(self.parameters.step_size, finer)
+                    ),
+                });
+                let backup = self.backup.as_ref().unwrap();
+                self.dynamics.as_mut().unwrap().state.copy_from(backup);
+                level = finer;
+                continue;
+            }
+            break result;
+        };
         let dynamics = self.dynamics.as_mut().unwrap();
-        if result.is_ok() && !dynamics.state.position.iter().all(|x| x.is_finite()) {
-            result = Err(Error::discard("the step produced non-finite positions"));
-        }
+        let result = result.and_then(|()| {
+            if dynamics.state.position.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(Error::discard("the step produced non-finite positions"))
+            }
+        });
         match result {
             Ok(()) => {
+                let quiet = self.step_error.is_some_and(|r| r < GROW_BELOW);
+                if controlled && quiet && level > 0 {
+                    level -= 1;
+                    self.events.push(LogEvent {
+                        category: category::EVENTS,
+                        message: format!(
+                            "model.accuracy: at t = {} the estimated error was {:.3} of its allowance; the next internal steps are at most {:e} s",
+                            t0 + big_h,
+                            self.step_error.unwrap_or(0.0),
+                            rung(self.parameters.step_size, level)
+                        ),
+                    });
+                }
+                dynamics.step_level = level;
                 self.finish_step(t0, big_h);
                 Ok(())
             }
@@ -59,10 +110,35 @@ impl Slave {
         }
     }
 
-    /// The number `n` and length `h` of the equal internal steps of a communication step from
-    /// `t_c` by `big_h`, no longer than `solver.stepSize` (and the explicit scheme's stable
-    /// step), after checking the request against the FMU's time.
-    fn internal_steps(&self, t_c: f64, big_h: f64) -> Result<(usize, f64)> {
+    /// The deformation scale's floor from the loads (docs/formulation.md, "Time error
+    /// control"): `‖ẍ‖_M / ω₁²` (m) at the communication point, the quasi-static displacement
+    /// of the current accelerations, so that a load that has just been applied sets the scale
+    /// before the body has deformed.
+    fn load_scale(&mut self) {
+        let model = self.model.as_ref().unwrap();
+        let dynamics = self.dynamics.as_mut().unwrap();
+        let period = model.first_period.unwrap();
+        let omega = 2.0 * std::f64::consts::PI / period;
+        let acceleration = mass_weighted_rms(
+            &model.body,
+            &dynamics.state.acceleration,
+            &mut self.scale_scratch,
+        );
+        dynamics.deformation_scale = dynamics
+            .deformation_scale
+            .max(acceleration / (omega * omega));
+    }
+
+    /// Whether the internal step is chosen by the error estimate (`model.accuracy > 0` with
+    /// generalized-α, the scheme that estimates its error).
+    fn error_controlled(&self) -> bool {
+        self.model
+            .as_ref()
+            .is_some_and(|m| m.first_period.is_some())
+    }
+
+    /// Checks a `fmi2DoStep` request against the FMU's time and state.
+    fn check_step_request(&self, t_c: f64, big_h: f64) -> Result<()> {
         if !(big_h.is_finite() && big_h > 0.0) {
             return Err(Error::invalid_value(
                 "communicationStepSize",
@@ -82,8 +158,14 @@ impl Slave {
                 &format!("does not match the FMU's time {t} (restore a state with fmi2SetFMUstate to go back)"),
             ));
         }
-        // The explicit scheme's internal step is limited to its stable step.
-        let step_size = self.parameters.step_size;
+        Ok(())
+    }
+
+    /// The number `n` and length `h` of the equal internal steps of a communication step
+    /// `big_h` (snapped) on rung `level`: no longer than `solver.stepSize / 2^level` (and the
+    /// explicit scheme's stable step).
+    fn internal_steps(&self, big_h: f64, level: u32) -> Result<(usize, f64)> {
+        let step_size = rung(self.parameters.step_size, level);
         let largest_step = self
             .model
             .as_ref()
@@ -96,7 +178,7 @@ impl Slave {
                 "needs more than 1e9 internal steps of solver.stepSize",
             ));
         }
-        Ok((substeps as usize, self.snapped_step(big_h) / substeps))
+        Ok((substeps as usize, big_h / substeps))
     }
 
     /// The communication step taken for `big_h`: importers that agree on the step compute it
@@ -115,11 +197,10 @@ impl Slave {
             .unwrap_or(big_h)
     }
 
-    /// Everything a communication step needs before its first internal step: the driving
-    /// frames, the factorization for `h` (on a cache miss; an error here leaves the state), the
+    /// Everything a communication step needs before its first internal step (the driving
+    /// frames are set before): the factorization for `h` (on a cache miss; an error here leaves the state), the
     /// terms in force, the geometric stiffness of the current prestress and the backup.
     fn prepare_step(&mut self, h: f64) -> Result<()> {
-        self.update_driving_frames()?;
         self.prepare_step_size(h)?;
         let model = self
             .model
@@ -169,6 +250,16 @@ impl Slave {
             extrapolate(load, d, age + big_h);
         }
         dynamics.gravity = self.parameters.gravity;
+        if self.step_error.is_some() {
+            let model = self.model.as_ref().unwrap();
+            let dynamics = self.dynamics.as_mut().unwrap();
+            let scale = mass_weighted_rms(
+                &model.body,
+                model.forces.force_scratch().local_deformation(),
+                &mut self.scale_scratch,
+            );
+            dynamics.deformation_scale = dynamics.deformation_scale.max(scale);
+        }
         self.outputs.valid = false;
         self.watch_strain(t0 + big_h);
         if self.results.is_some() {
@@ -294,9 +385,28 @@ impl Slave {
         m: usize,
         last_of_step: bool,
     ) -> Result<()> {
-        let settings = IterationSettings {
-            absolute_tolerance: self.parameters.tolerance * self.size,
+        let floor = self.parameters.tolerance * self.size;
+        let mut settings = IterationSettings {
+            absolute_tolerance: floor,
             max_iterations: self.parameters.max_iterations.max(1) as usize,
+            estimate_error: None,
+        };
+        let controlled = self.error_controlled();
+        let jumped = self.inputs_jumped;
+        // The allowance of these internal steps, from the deformation scale at the
+        // communication point (it is updated once per communication step, in finish_step).
+        let allowed = match (controlled, self.model.as_ref().and_then(|m| m.first_period)) {
+            (true, Some(period)) => {
+                let scale = self.dynamics.as_ref().unwrap().deformation_scale;
+                allowance(
+                    self.parameters.accuracy,
+                    scale,
+                    hs,
+                    period,
+                    ITERATION_NOISE * floor,
+                )
+            }
+            _ => f64::INFINITY,
         };
         let model = self.model.as_mut().expect("the model exists during a step");
         let dynamics = self.dynamics.as_mut().unwrap();
@@ -340,11 +450,18 @@ impl Slave {
             prescribe: &prescribe,
         };
         for j in 0..m {
-            tau.set(if last_of_step && j + 1 == m {
+            let last = last_of_step && j + 1 == m;
+            tau.set(if last {
                 big_h
             } else {
                 tau0 + (j + 1) as f64 * hs
             });
+            // The error is estimated on the first internal step of a communication step (where
+            // the inputs jump) and on the last (where the outputs are read): docs/formulation.md,
+            // "Time error control".
+            let first = tau0 == 0.0 && j == 0;
+            settings.estimate_error = (controlled && (last || first) && !(first && jumped))
+                .then_some(GROW_BELOW * allowed);
             let report = model.integrator.step(
                 &problem,
                 &radau_problem,
@@ -355,7 +472,18 @@ impl Slave {
             )?;
             self.statistics.0 += 1;
             self.statistics.1 += report.iterations as u64;
+            if let Some(e) = report.error_estimate {
+                self.step_error = Some(self.step_error.unwrap_or(0.0).max(e / allowed));
+            }
         }
         Ok(())
     }
+}
+
+/// `√(uᵀ M u / m)`: the mass-weighted RMS of a field `u` (flat `3N`, in its units); `y` is
+/// scratch of `3N`.
+fn mass_weighted_rms(body: &crate::body::Body, u: &[f64], y: &mut [f64]) -> f64 {
+    body.mass_times(u, y);
+    let squared: f64 = u.iter().zip(y.iter()).map(|(u, m)| u * m).sum();
+    (squared.max(0.0) / body.total_mass).sqrt()
 }

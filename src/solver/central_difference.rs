@@ -197,6 +197,7 @@ impl CentralDifference {
         Ok(StepReport {
             iterations: 0,
             last_correction: 0.0,
+            error_estimate: None,
         })
     }
 }

@@ -170,6 +170,7 @@ mod tests {
         let settings = IterationSettings {
             absolute_tolerance: 1e-6,
             max_iterations: 10,
+            estimate_error: None,
         };
         let mut c = Convergence::new("", &settings, 1.0, 0.1);
         // First correction above the tolerance: no estimate yet.

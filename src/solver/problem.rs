@@ -155,6 +155,10 @@ pub struct StepReport {
     pub iterations: usize,
     /// Largest position correction of the last iteration (m).
     pub last_correction: f64,
+    /// The step's estimated local error (m, mass-weighted RMS over the body), when
+    /// [`IterationSettings::estimate_error`] asked for it and the scheme has an estimate
+    /// (generalized-α: `generalized_alpha::IterationMatrix::local_error`).
+    pub error_estimate: Option<f64>,
 }
 
 /// Settings of the fixed-point iteration of the implicit schemes (`fixed_point::Convergence`).
@@ -165,6 +169,10 @@ pub struct IterationSettings {
     /// (`fixed_point::remaining_error`).
     pub absolute_tolerance: f64,
     pub max_iterations: usize,
+    /// `Some(enough)`: the step estimates its local error ([`StepReport::error_estimate`], m;
+    /// for the slave's step-size control, docs/formulation.md "Time error control"), and may
+    /// stop refining the estimate once it knows it is below `enough`.
+    pub estimate_error: Option<f64>,
 }
 
 /// Sets the positions, velocities and accelerations of the clamped (prescribed) nodes at a time.

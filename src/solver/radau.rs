@@ -344,6 +344,7 @@ fn iterate(
             return Ok(StepReport {
                 iterations: iteration,
                 last_correction: convergence.last_correction(),
+                error_estimate: None,
             });
         }
     }

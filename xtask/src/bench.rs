@@ -7,6 +7,8 @@
 //! * `b3_table`: B3 through the slave for every model choice, `full` as the yardstick (issue 4);
 //! * `b2_drift`: B2's angular momentum and energy drift with and without `f_nl` and frames;
 //! * `work_precision`: run time against error on B1 and B3 for each formulation (CSV);
+//! * `accuracy_table`: `model.accuracy`'s error achieved against the error requested, and its
+//!   run time against the cheapest fixed internal step of the same error (B1, B3);
 //! * `soak`: 10⁶ steps of the undamped cantilever, energy drift and resident memory (issue 7);
 //! * `step_scaling`: a step against one solve from 384 to ~100k DOF (CSV);
 //! * the peers: `export_matrices` writes B1's mesh and matrices, `bench/peers.py` runs Exudyn's
@@ -63,6 +65,13 @@ const SUITE: &[Entry] = &[
         args: &[],
         quick_args: &["--quick"],
         csv: Some("work_precision"),
+    },
+    Entry {
+        title: "model.accuracy: the error achieved and the cost against the cheapest fixed step",
+        example: "accuracy_table",
+        args: &[],
+        quick_args: &["--quick"],
+        csv: None,
     },
     Entry {
         title: "Soak: 10⁶ steps of the undamped cantilever (energy drift, resident memory)",

@@ -1,0 +1,245 @@
+//! `model.accuracy` (docs/formulation.md, "Time error control"): the error achieved against the
+//! error requested, and the run time against the cheapest fixed internal step that reaches the
+//! same error, through `flexbody::slave::Slave` as an importer drives the FMU.
+//!
+//! `cargo run --release --example accuracy_table -- [--quick]`
+//!
+//! * **B1**: the default cantilever (hex20 20×2×2, 1863 DOF), 10 N step load in −y on `tip` at
+//!   t = 0, no damping, ρ∞ = 0.9, 0.1 s, communication step 2 ms, `solver.stepSize` 2 ms (the top
+//!   of the ladder). Error: the largest |Δ tip y| over the communication points against the fixed
+//!   step h = 5e-6 s, divided by the peak |tip y|. The fixed steps `2 ms / 2^k`, k = 0…8, are
+//!   the hand-chosen settings; "cheapest fixed" is the fastest of them whose error is at most the
+//!   controlled run's, and "interpolated" the time a fixed step of exactly that error would take
+//!   (error ∝ h² and time ∝ 1/h between the two neighbouring rows). Wall times: median of 3.
+//! * **B3**: `examples/hub_beam.json` spun up by the hub schedule for 20 s, communication step
+//!   10 ms, `solver.stepSize` 10 ms; error: the largest |Δ tip deflection| in the hub frame
+//!   against `full` at h = 2.5 ms, over its peak. One run each.
+//!
+//! `--quick` (for checking the task): B1 over 0.04 s against h = 2e-5 s with two accuracies, B3
+//! over 2 s against `full` at 5 ms.
+
+use flexbody::model::BodyFile;
+use flexbody::slave::Slave;
+use std::time::Instant;
+#[path = "../tests/common/b3.rs"]
+mod b3;
+#[path = "support/mod.rs"]
+mod support;
+use support::median;
+
+fn vr(s: &Slave, name: &str) -> u32 {
+    s.variables().by_name(name).unwrap().value_reference
+}
+
+/// A run's result: the output samples, the wall time of the stepping loop (s), internal steps
+/// and communication steps redone.
+struct Run {
+    samples: Vec<f64>,
+    wall: f64,
+    steps: u64,
+    redone: u64,
+}
+
+fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
+    let mut s = Slave::from_body(body).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    for &(name, value) in settings {
+        s.set_by_name(name, value).unwrap();
+    }
+    s
+}
+
+fn b1(settings: &[(&str, f64)], end: f64) -> Run {
+    let mut s = slave(BodyFile::default_body(), settings);
+    s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
+    s.exit_initialization_mode().unwrap();
+    let tip = vr(&s, "tip.position[2]");
+    let y0 = s.get_real(tip).unwrap();
+    let dt = 2e-3;
+    let n = (end / dt).round() as usize;
+    let mut samples = Vec::with_capacity(n);
+    let started = Instant::now();
+    for k in 0..n {
+        s.do_step(k as f64 * dt, dt).unwrap();
+        samples.push(s.get_real(tip).unwrap() - y0);
+    }
+    let wall = started.elapsed().as_secs_f64();
+    Run {
+        samples,
+        wall,
+        steps: s.solver_statistics().0,
+        redone: s.rejected_steps(),
+    }
+}
+
+fn b3(settings: &[(&str, f64)], end: f64, dt: f64) -> Run {
+    let text = std::fs::read_to_string("examples/hub_beam.json").unwrap();
+    let mut s = slave(BodyFile::from_json(&text).unwrap(), settings);
+    s.exit_initialization_mode().unwrap();
+    let drive = b3::HubDrive::new(&s);
+    let n = (end / dt).round() as usize;
+    let mut samples = Vec::with_capacity(n);
+    let started = Instant::now();
+    for k in 0..n {
+        samples.push(drive.step(&mut s, k as f64 * dt, dt).unwrap());
+    }
+    let wall = started.elapsed().as_secs_f64();
+    Run {
+        samples,
+        wall,
+        steps: s.solver_statistics().0,
+        redone: s.rejected_steps(),
+    }
+}
+
+/// The largest difference over the samples, over the reference's peak.
+fn relative_error(y: &[f64], reference: &[f64]) -> f64 {
+    let peak = reference.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    y.iter()
+        .zip(reference)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()))
+        / peak
+}
+
+/// The median wall time of `repeats` runs (the samples and counters of the last).
+fn timed(repeats: usize, run: impl Fn() -> Run) -> Run {
+    let mut walls = Vec::new();
+    let mut last = None;
+    for _ in 0..repeats {
+        let r = run();
+        walls.push(r.wall);
+        last = Some(r);
+    }
+    let mut r = last.unwrap();
+    r.wall = median(walls);
+    r
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let repeats = if quick { 1 } else { 3 };
+
+    // ---- B1 ----------------------------------------------------------------------------------
+    let end = if quick { 0.04 } else { 0.1 };
+    let h_ref = if quick { 2e-5 } else { 5e-6 };
+    let top = 2e-3;
+    let reference = b1(&[("solver.stepSize", h_ref)], end).samples;
+    println!(
+        "B1: 10 N step load, {end} s, communication step 2 ms, solver.stepSize {top} s; reference: fixed step {h_ref:e} s\n"
+    );
+    println!("| setting | internal steps | redone | wall (ms) | error / peak |");
+    println!("|---|---|---|---|---|");
+    let mut fixed = Vec::new();
+    let rungs = if quick { 5 } else { 9 };
+    for k in 0..rungs {
+        let h = top / f64::from(1u32 << k);
+        let r = timed(repeats, || b1(&[("solver.stepSize", h)], end));
+        let e = relative_error(&r.samples, &reference);
+        println!(
+            "| fixed h = {h:e} s | {} | | {:.1} | {e:.3e} |",
+            r.steps,
+            r.wall * 1e3
+        );
+        fixed.push((h, r.wall, e));
+    }
+    let accuracies: &[f64] = if quick {
+        &[1e-2, 1e-3]
+    } else {
+        &[1e-2, 1e-3, 1e-4]
+    };
+    let mut rows = Vec::new();
+    for &accuracy in accuracies {
+        let r = timed(repeats, || {
+            b1(
+                &[("solver.stepSize", top), ("model.accuracy", accuracy)],
+                end,
+            )
+        });
+        let e = relative_error(&r.samples, &reference);
+        println!(
+            "| model.accuracy = {accuracy:e} | {} | {} | {:.1} | {e:.3e} |",
+            r.steps,
+            r.redone,
+            r.wall * 1e3
+        );
+        rows.push((accuracy, r.wall, e));
+    }
+    println!(
+        "\n| model.accuracy | error / peak | within? | wall (ms) | cheapest fixed step with at most that error | its wall (ms) | ours / it | interpolated fixed wall (ms) | ours / interpolated |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for &(accuracy, wall, e) in &rows {
+        let cheapest = fixed
+            .iter()
+            .filter(|f| f.2 <= e)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        // Between the coarsest fixed step within the error and the next coarser one: error ∝ h²,
+        // time ∝ 1/h.
+        let interpolated = fixed
+            .windows(2)
+            .find(|w| w[0].2 > e && w[1].2 <= e)
+            .map(|w| {
+                let (h1, wall1, e1) = w[1];
+                let h = h1 * (e / e1).sqrt();
+                wall1 * h1 / h
+            });
+        let within = if e <= accuracy { "yes" } else { "no" };
+        match cheapest {
+            Some(&(h, fixed_wall, _)) => println!(
+                "| {accuracy:e} | {e:.3e} | {within} | {:.1} | {h:e} s | {:.1} | {:.2} | {} | {} |",
+                wall * 1e3,
+                fixed_wall * 1e3,
+                wall / fixed_wall,
+                interpolated.map_or("".into(), |w| format!("{:.1}", w * 1e3)),
+                interpolated.map_or("".into(), |w| format!("{:.2}", wall / w)),
+            ),
+            None => println!(
+                "| {accuracy:e} | {e:.3e} | {within} | {:.1} | none of the fixed steps | | | | |",
+                wall * 1e3
+            ),
+        }
+    }
+
+    // ---- B3 ----------------------------------------------------------------------------------
+    let end = if quick { 2.0 } else { 20.0 };
+    let h_ref = if quick { 5e-3 } else { 2.5e-3 };
+    let reference = b3(
+        &[("model.formulation", 2.0), ("solver.stepSize", h_ref)],
+        end,
+        h_ref,
+    )
+    .samples
+    .iter()
+    .enumerate()
+    .filter(|(k, _)| (k + 1) % ((1e-2 / h_ref).round() as usize) == 0)
+    .map(|(_, &y)| y)
+    .collect::<Vec<f64>>();
+    println!(
+        "\nB3: hub schedule, {end} s, communication step 10 ms; reference: `full` at h = {h_ref:e} s (the default model's error against it is the single frame's)\n"
+    );
+    println!("| setting | internal steps | redone | wall (ms) | error / peak |");
+    println!("|---|---|---|---|---|");
+    let settings: Vec<(String, Vec<(&str, f64)>)> = vec![
+        ("fixed h = 1e-2 s".into(), vec![("solver.stepSize", 1e-2)]),
+        ("fixed h = 5e-3 s".into(), vec![("solver.stepSize", 5e-3)]),
+        (
+            "model.accuracy = 1e-2".into(),
+            vec![("solver.stepSize", 1e-2), ("model.accuracy", 1e-2)],
+        ),
+        (
+            "model.accuracy = 1e-3".into(),
+            vec![("solver.stepSize", 1e-2), ("model.accuracy", 1e-3)],
+        ),
+    ];
+    for (label, setting) in &settings {
+        let r = b3(setting, end, 1e-2);
+        println!(
+            "| {label} | {} | {} | {:.1} | {:.3e} |",
+            r.steps,
+            r.redone,
+            r.wall * 1e3,
+            relative_error(&r.samples, &reference)
+        );
+    }
+}

@@ -1,0 +1,190 @@
+//! `model.accuracy` (docs/formulation.md, "Time error control"): the internal step chosen from
+//! the ladder `solver.stepSize / 2^k` by the local error estimate, through the slave as an
+//! importer drives it.
+//!
+//! The scene: B1's beam on a coarse mesh (hex20 10×1×1, so that the fine references stay cheap
+//! in a debug build) under a 10 N step load at the tip from t = 0, no damping unless said,
+//! communication step 2 ms, `solver.stepSize` 2 ms. The step load rings the high modes of the
+//! mesh, which the tip carries: with the fixed step the tip is off by 3 % of its peak.
+
+use flexbody::model::BodyFile;
+use flexbody::slave::Slave;
+
+const H: f64 = 2e-3;
+
+fn body() -> BodyFile {
+    let text = include_str!("../examples/cantilever.json").replace("[20, 2, 2]", "[10, 1, 1]");
+    BodyFile::from_json(&text).unwrap()
+}
+
+fn vr(s: &Slave, name: &str) -> u32 {
+    s.variables().by_name(name).unwrap().value_reference
+}
+
+/// A slave of `body` with `settings` (by name), the 10 N tip load set, initialized.
+fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
+    let mut s = Slave::from_body(body).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.set_by_name("solver.stepSize", H).unwrap();
+    for &(name, value) in settings {
+        s.set_by_name(name, value).unwrap();
+    }
+    s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
+    s.exit_initialization_mode().unwrap();
+    s
+}
+
+/// Tip y (m) relative to the start at every communication point up to `end`.
+fn tip_history(s: &mut Slave, end: f64) -> Vec<f64> {
+    let tip = vr(s, "tip.position[2]");
+    let y0 = s.get_real(tip).unwrap();
+    let n = (end / H).round() as usize;
+    (0..n)
+        .map(|k| {
+            s.do_step(k as f64 * H, H).unwrap();
+            s.get_real(tip).unwrap() - y0
+        })
+        .collect()
+}
+
+fn largest_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+fn peak(a: &[f64]) -> f64 {
+    a.iter().fold(0.0_f64, |m, x| m.max(x.abs()))
+}
+
+#[test]
+fn the_controlled_step_meets_the_accuracy() {
+    // Against the fixed step at h = 5e-6 s (its own error is 4e-5 of the peak by the h² rule
+    // from the fixed-step rows below), over 0.1 s (1.7 periods of the first mode).
+    let end = 0.1;
+    let mut fine = slave(
+        body(),
+        &[("model.accuracy", 0.0), ("solver.stepSize", 5e-6)],
+    );
+    let reference = tip_history(&mut fine, end);
+    let peak = peak(&reference);
+    let mut fixed = slave(body(), &[("model.accuracy", 0.0)]);
+    let fixed_error = largest_difference(&tip_history(&mut fixed, end), &reference) / peak;
+    println!("fixed step {H} s: error {fixed_error:.3e} of the peak");
+    assert!(
+        fixed_error > 1e-2,
+        "the scene needs a finer step than solver.stepSize"
+    );
+    for accuracy in [1e-2, 1e-3] {
+        let mut s = slave(body(), &[("model.accuracy", accuracy)]);
+        let error = largest_difference(&tip_history(&mut s, end), &reference) / peak;
+        let (steps, _) = s.solver_statistics();
+        println!(
+            "model.accuracy = {accuracy:e}: error {error:.3e} of the peak, {steps} internal steps, {} communication steps redone",
+            s.rejected_steps()
+        );
+        assert!(error <= accuracy, "accuracy {accuracy}: error {error:.3e}");
+    }
+}
+
+#[test]
+fn estimating_the_error_leaves_the_trajectory_alone() {
+    // With an accuracy that the step meets from the start the control never acts: the
+    // trajectory is bit for bit that of the fixed step (the estimate reads the state only).
+    let end = 0.04;
+    let mut fixed = slave(body(), &[("model.accuracy", 0.0)]);
+    let mut controlled = slave(body(), &[("model.accuracy", 0.99)]);
+    let a = tip_history(&mut fixed, end);
+    let b = tip_history(&mut controlled, end);
+    assert_eq!(controlled.rejected_steps(), 0);
+    assert_eq!(controlled.controlled_step_size(), H);
+    assert_eq!(a, b);
+}
+
+#[test]
+fn the_ladder_reuses_its_factorizations_and_the_decisions_are_logged() {
+    // Damped (β = 2e-5 s: the modes above ~3 kHz lose half their amplitude within a
+    // millisecond, the first mode is barely touched), the ringing dies down: the control
+    // refines at t = 0, where the step load rings every mode, and steps up the ladder as the
+    // ringing decays, each decision logged once. Every internal step size is a rung, and no
+    // rung is factorised twice.
+    let body = body();
+    let mut s = slave(body, &[("model.accuracy", 1e-3), ("damping.beta", 2e-5)]);
+    let assembly: Vec<String> = s.drain_events().map(|e| e.message).collect();
+    assert!(assembly.iter().any(|m| m.contains("model.accuracy = 1e-3")));
+    let mut refined_at = Vec::new();
+    let mut coarsened_at = Vec::new();
+    let mut factorised_at = Vec::new();
+    let n = (0.4 / H).round() as usize;
+    for k in 0..n {
+        let t = k as f64 * H;
+        s.do_step(t, H).unwrap();
+        for e in s.drain_events() {
+            if e.message.contains("redone with internal steps") {
+                refined_at.push(t);
+            } else if e.message.contains("the next internal steps are at most") {
+                coarsened_at.push(t);
+            } else if e.message.contains("factorised") {
+                let size = e.message.split("h = ").nth(1).unwrap();
+                factorised_at.push((t, size.split(' ').next().unwrap().to_string()));
+            }
+        }
+        let h = s.controlled_step_size();
+        let level = (H / h).log2();
+        assert!((level - level.round()).abs() < 1e-12, "{h} is not a rung");
+    }
+    println!(
+        "refined at {refined_at:?}, coarsened at {coarsened_at:?}, factorised at {factorised_at:?}"
+    );
+    assert!(
+        refined_at.contains(&0.0),
+        "the step load at t = 0 needs a finer step"
+    );
+    assert!(
+        coarsened_at.iter().any(|&t| t > 0.0),
+        "the step grows back as the ringing decays"
+    );
+    assert_eq!(
+        s.rejected_steps(),
+        refined_at.len() as u64,
+        "every redone step is logged"
+    );
+    // Each rung is factorised on its first visit only (the cache holds four, and the run
+    // visits no more than that while the earlier ones are still in use).
+    let mut sizes: Vec<&String> = factorised_at.iter().map(|(_, size)| size).collect();
+    sizes.sort();
+    sizes.dedup();
+    assert_eq!(sizes.len(), factorised_at.len(), "a rung factorised twice");
+}
+
+#[test]
+fn the_state_carries_the_rung() {
+    // The rung and the deformation scale are part of the FMU state: restoring a state taken
+    // while refined replays the same steps bit for bit.
+    let mut s = slave(body(), &[("model.accuracy", 1e-3)]);
+    tip_history(&mut s, 0.01);
+    let saved = s.get_state();
+    let h = s.controlled_step_size();
+    assert!(h < H, "refined after the step load");
+    let t = s.time();
+    let tip = vr(&s, "tip.position[2]");
+    let run = |s: &mut Slave| {
+        (0..10)
+            .map(|k| {
+                s.do_step(t + k as f64 * H, H).unwrap();
+                s.get_real(tip).unwrap()
+            })
+            .collect::<Vec<f64>>()
+    };
+    let first = run(&mut s);
+    let bytes = {
+        let mut b = Vec::new();
+        flexbody::slave::CoSimSlave::state_to_bytes(&s, &saved, &mut b);
+        b
+    };
+    let restored = s.state_from_bytes(&bytes).unwrap();
+    s.set_state(&restored).unwrap();
+    assert_eq!(s.controlled_step_size(), h);
+    assert_eq!(run(&mut s), first);
+}
