@@ -188,3 +188,24 @@ fn the_state_carries_the_rung() {
     assert_eq!(s.controlled_step_size(), h);
     assert_eq!(run(&mut s), first);
 }
+
+#[test]
+fn model_accuracy_is_a_parameter_with_its_default_in_the_model_description() {
+    // Default 1e-2 (docs/fmu.md, "Parameters": why not 1e-3), from the body file's
+    // `"model": { "accuracy": … }`; out of [0, 1) it is refused with the variable's name.
+    let mut s = Slave::from_body(body()).unwrap();
+    let accuracy = vr(&s, "model.accuracy");
+    assert_eq!(s.get_real(accuracy).unwrap(), 1e-2);
+    let xml = s.model_description();
+    assert!(xml.contains(r#"name="model.accuracy""#), "{xml}");
+    for bad in [-1e-3, 1.0, f64::NAN] {
+        let e = s.set_real(accuracy, bad).unwrap_err();
+        assert!(e.message.contains("model.accuracy"), "{}", e.message);
+    }
+    let text = include_str!("../examples/cantilever.json").replace(
+        r#""model": { "nonlinearForces": false }"#,
+        r#""model": { "nonlinearForces": false, "accuracy": 1e-4 }"#,
+    );
+    let s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
+    assert_eq!(s.parameters().accuracy, 1e-4);
+}

@@ -282,7 +282,7 @@ impl ModelSpec {
         true
     }
     fn default_accuracy() -> f64 {
-        0.0
+        1e-2
     }
 }
 

@@ -558,12 +558,11 @@ fn lowest_period(free: &FreeNodes, indicators: Option<&FeatureIndicators>) -> Re
             let (shift, index) = if supported {
                 (0.0, 0)
             } else {
-                // The smallest diagonal ratio bounds ω₁² from above by far on a mesh; 1e-6 of it
-                // keeps K + σM well conditioned and moves ω₁² by a negligible amount.
-                let smallest = (0..k.n)
-                    .map(|i| diagonal(k, i) / diagonal(m, i).max(f64::MIN_POSITIVE))
-                    .fold(f64::INFINITY, f64::min);
-                (1e-6 * smallest, 6)
+                // 1e-8 of the mean diagonal ratio (a mean of ω² over the mesh, far above ω₁²)
+                // keeps K + σM positive definite and costs a negligible part of ω₁² + σ's
+                // digits.
+                let trace = |a: &SymmetricCsr| (0..a.n).map(|i| diagonal(a, i)).sum::<f64>();
+                (1e-8 * trace(k) / trace(m), 6)
             };
             let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
             let count = (index + 1).min(k.n);
