@@ -35,6 +35,8 @@ fn main() {
             set(&mut s, &format!("initial.velocity[{}]", k + 1), v[k]);
         }
         set(&mut s, "solver.stepSize", h);
+        // Measured at the fixed step h.
+        set(&mut s, "model.accuracy", 0.0);
         set(&mut s, "material.youngsModulus", 2.1e8);
         set(&mut s, "model.nonlinearForces", f64::from(u8::from(f_nl)));
         set(&mut s, "model.frames", f64::from(frames));

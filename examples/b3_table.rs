@@ -28,6 +28,9 @@ fn run(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Result<Run, String>
     s.setup_experiment(0.0, None, None).map_err(|e| e.message)?;
     s.enter_initialization_mode().map_err(|e| e.message)?;
     s.set_by_name("solver.stepSize", h).map_err(|e| e.message)?;
+    // Measured at the fixed step h.
+    s.set_by_name("model.accuracy", 0.0)
+        .map_err(|e| e.message)?;
     for (name, value) in settings {
         s.set_by_name(name, f64::from(*value))
             .map_err(|e| e.message)?;

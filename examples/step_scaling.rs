@@ -55,6 +55,8 @@ fn main() {
         s.setup_experiment(0.0, None, None).unwrap();
         s.enter_initialization_mode().unwrap();
         s.set_by_name("solver.stepSize", h).unwrap();
+        // Measured at the fixed step h.
+        s.set_by_name("model.accuracy", 0.0).unwrap();
         s.set_by_name("tip.force[2]", -10.0).unwrap();
         s.exit_initialization_mode().unwrap();
         let mut t = 0.0;

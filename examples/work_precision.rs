@@ -101,6 +101,8 @@ fn slave(body: &BodyFile, h: f64, settings: &[(&str, i32)]) -> Slave {
     s.setup_experiment(0.0, None, None).unwrap();
     s.enter_initialization_mode().unwrap();
     s.set_by_name("solver.stepSize", h).unwrap();
+    // Measured at the fixed step h.
+    s.set_by_name("model.accuracy", 0.0).unwrap();
     for (name, value) in settings {
         s.set_by_name(name, f64::from(*value)).unwrap();
     }
