@@ -40,6 +40,18 @@ struct Run {
     redone: u64,
 }
 
+impl Run {
+    /// The run of `s` that started at `started` and gave `samples`.
+    fn of(s: &Slave, samples: Vec<f64>, started: Instant) -> Run {
+        Run {
+            samples,
+            wall: started.elapsed().as_secs_f64(),
+            steps: s.solver_statistics().0,
+            redone: s.rejected_steps(),
+        }
+    }
+}
+
 fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
     let mut s = Slave::from_body(body).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();
@@ -64,13 +76,7 @@ fn b1(settings: &[(&str, f64)], end: f64) -> Run {
         s.do_step(k as f64 * dt, dt).unwrap();
         samples.push(s.get_real(tip).unwrap() - y0);
     }
-    let wall = started.elapsed().as_secs_f64();
-    Run {
-        samples,
-        wall,
-        steps: s.solver_statistics().0,
-        redone: s.rejected_steps(),
-    }
+    Run::of(&s, samples, started)
 }
 
 fn b3(settings: &[(&str, f64)], end: f64, dt: f64) -> Run {
@@ -84,13 +90,7 @@ fn b3(settings: &[(&str, f64)], end: f64, dt: f64) -> Run {
     for k in 0..n {
         samples.push(drive.step(&mut s, k as f64 * dt, dt).unwrap());
     }
-    let wall = started.elapsed().as_secs_f64();
-    Run {
-        samples,
-        wall,
-        steps: s.solver_statistics().0,
-        redone: s.rejected_steps(),
-    }
+    Run::of(&s, samples, started)
 }
 
 /// The largest difference over the samples, over the reference's peak.

@@ -98,22 +98,29 @@ fn initial_state(c: &Cantilever) -> DynamicState {
     }
 }
 
-/// Mean tip deflection at t = k·H, H = 1 ms, up to 2T, with steps h = H/m.
-fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
-    let big_h = 1e-3;
-    let h = big_h / m as f64;
+/// `steps` steps of `h` under the pulse from rest with consistent accelerations (smooth: the
+/// pulse starts with zero load and zero load rate), `each(n, state)` after step `n`; the state
+/// at the end.
+fn pulse_run(
+    c: &Cantilever,
+    h: f64,
+    rho_inf: f64,
+    steps: usize,
+    mut each: impl FnMut(usize, &DynamicState),
+) -> DynamicState {
     let scheme = GeneralizedAlpha::new(rho_inf);
     let mut matrix = IterationMatrix::new(&c.body, &c.free, &scheme, h, 0.0, 0.0).unwrap();
     let mut ws = StepWorkspace::new(&c.body, &c.free);
     let mut forces = ResidualWorkspace::new(&c.body);
     let mut state = initial_state(c);
     let mut mass = ConsistentAcceleration::new(&c.free).unwrap();
+    let (state_ref, forces_ref) = (&mut state, &mut forces);
     initial_acceleration(
         &c.body,
         &c.free,
         &load(c, 0.0),
-        &mut state,
-        &mut forces,
+        state_ref,
+        forces_ref,
         &mut mass,
     )
     .unwrap();
@@ -122,16 +129,27 @@ fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
         max_iterations: 50,
         estimate_error: None,
     };
-    let mut tip = Vec::new();
-    for n in 1..=((2.0 * PULSE / h).round() as usize) {
+    for n in 1..=steps {
         let loads = load(c, n as f64 * h);
         let problem = c.problem(&loads);
-        let (state, ws, forces) = (&mut state, &mut ws, &mut forces);
-        generalized_alpha::step(&problem, &mut matrix, &settings, h, state, ws, forces).unwrap();
+        let (state_ref, ws, forces) = (&mut state, &mut ws, &mut forces);
+        generalized_alpha::step(&problem, &mut matrix, &settings, h, state_ref, ws, forces)
+            .unwrap();
+        each(n, &state);
+    }
+    state
+}
+
+/// Mean tip deflection at t = k·H, H = 1 ms, up to 2T, with steps h = H/m.
+fn run(c: &Cantilever, m: usize, rho_inf: f64) -> Vec<f64> {
+    let h = 1e-3 / m as f64;
+    let mut tip = Vec::new();
+    let steps = (2.0 * PULSE / h).round() as usize;
+    pulse_run(c, h, rho_inf, steps, |n, state| {
         if n % m == 0 {
             tip.push(c.tip_deflection(&state.position));
         }
-    }
+    });
     tip
 }
 
@@ -274,37 +292,9 @@ fn central_difference_is_second_order_and_refuses_an_unstable_step() {
     assert_eq!(state, before);
 }
 
-/// The state at `t` after steps of `h` under the pulse (smooth: it starts with zero load and
-/// zero load rate).
+/// The state at `t` after steps of `h` under the pulse.
 fn state_at(c: &Cantilever, t: f64, h: f64, rho_inf: f64) -> DynamicState {
-    let scheme = GeneralizedAlpha::new(rho_inf);
-    let mut matrix = IterationMatrix::new(&c.body, &c.free, &scheme, h, 0.0, 0.0).unwrap();
-    let mut ws = StepWorkspace::new(&c.body, &c.free);
-    let mut forces = ResidualWorkspace::new(&c.body);
-    let mut state = initial_state(c);
-    let mut mass = ConsistentAcceleration::new(&c.free).unwrap();
-    let (state_ref, forces_ref) = (&mut state, &mut forces);
-    initial_acceleration(
-        &c.body,
-        &c.free,
-        &load(c, 0.0),
-        state_ref,
-        forces_ref,
-        &mut mass,
-    )
-    .unwrap();
-    let settings = IterationSettings {
-        absolute_tolerance: 1e-14,
-        max_iterations: 50,
-        estimate_error: None,
-    };
-    for n in 1..=((t / h).round() as usize) {
-        let loads = load(c, n as f64 * h);
-        let problem = c.problem(&loads);
-        let (state, ws, forces) = (&mut state, &mut ws, &mut forces);
-        generalized_alpha::step(&problem, &mut matrix, &settings, h, state, ws, forces).unwrap();
-    }
-    state
+    pulse_run(c, h, rho_inf, (t / h).round() as usize, |_, _| {})
 }
 
 /// `m` steps of `h / m` from `start`; the error estimate of the last one (m, asked with
