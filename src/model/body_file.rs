@@ -252,7 +252,8 @@ pub struct ModelSpec {
     #[serde(default)]
     pub modes: u32,
     /// `model.auto` (default true): the nonlinear force and the stiffening are upper bounds, each
-    /// switched on per step only when it changes the result beyond the solver tolerance.
+    /// switched on per step only when it changes the result beyond the solver tolerance; `f_nl`
+    /// stays off on a supported body with one frame.
     #[serde(default = "ModelSpec::default_auto")]
     pub auto: bool,
     /// `model.accuracy`: the accepted error relative to the deformation scale, which sets the
