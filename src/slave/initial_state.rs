@@ -42,8 +42,13 @@ impl Slave {
                 nonlinear_forces: model.allowed.nonlinear_forces
                     && !ind.estimates_nonlinear_forces(),
                 stiffening: model.allowed.stiffening && !ind.estimates_stiffening(),
+                frames: false,
+                frames_refused: false,
             },
-            None => model.allowed,
+            None => Features {
+                frames: false,
+                ..model.allowed
+            },
         };
         model.apply_features(features);
         let body = &model.body;

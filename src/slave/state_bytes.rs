@@ -15,7 +15,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64 |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64 |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -29,7 +29,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 4;
+pub const PAYLOAD_FORMAT: u32 = 5;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -201,7 +201,10 @@ impl SlaveState {
                 w.f64s(&s.multipliers);
                 d.loads.iter().for_each(|l| w.f64s(l));
                 w.f64s(&d.gravity);
-                w.u8(u8::from(d.features.nonlinear_forces) | u8::from(d.features.stiffening) << 1);
+                w.u8(u8::from(d.features.nonlinear_forces)
+                    | u8::from(d.features.stiffening) << 1
+                    | u8::from(d.features.frames) << 2
+                    | u8::from(d.features.frames_refused) << 3);
                 w.f64s(&d.quiet_since);
                 w.u32(d.step_level);
                 w.f64(d.deformation_scale);
@@ -364,13 +367,15 @@ impl Slave {
                 let mut gravity = [0.0; 3];
                 r.f64s(&mut gravity, "the gravity of the state")?;
                 let features = match r.u8("the terms in force")? {
-                    b @ 0..=3 => super::Features {
+                    b @ 0..=15 => super::Features {
                         nonlinear_forces: b & 1 != 0,
                         stiffening: b & 2 != 0,
+                        frames: b & 4 != 0,
+                        frames_refused: b & 8 != 0,
                     },
                     b => {
                         return Err(Error::new(format!(
-                            "the serialized FMU state holds {b} for the terms in force: not 0 to 3"
+                            "the serialized FMU state holds {b} for the terms in force: not 0 to 15"
                         )))
                     }
                 };

@@ -36,6 +36,7 @@ impl Slave {
         let t0 = self.time();
         let controlled = self.error_controlled();
         let mut level = self.dynamics.as_ref().unwrap().step_level;
+        let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
         self.inputs_jumped = self.update_driving_frames()?;
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
@@ -58,6 +59,25 @@ impl Slave {
                 if result.is_err() || redo {
                     break;
                 }
+            }
+            let dynamics = self.dynamics.as_mut().unwrap();
+            let switched = dynamics.features.frames && !slabs_before;
+            if switched && result.as_ref().is_err_and(|e| e.kind == ErrorKind::Discard) {
+                // model.auto's slabs, switched on at this communication point, did not
+                // converge: the step is redone with the one frame, for good.
+                dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                dynamics.features.frames = false;
+                dynamics.features.frames_refused = true;
+                let model = self.model.as_mut().unwrap();
+                model.apply_features(dynamics.features);
+                self.events.push(LogEvent {
+                    category: category::EVENTS,
+                    message: format!(
+                        "model.auto: the step from t = {t0} did not converge with the slabs switched on ({}); redone with the one co-moving frame, which the body keeps",
+                        result.unwrap_err().message
+                    ),
+                });
+                continue;
             }
             let ratio = self.step_error.unwrap_or(0.0);
             if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
@@ -211,6 +231,7 @@ impl Slave {
             model,
             dynamics,
             self.parameters.tolerance * self.size,
+            self.parameters.accuracy,
             &mut self.events,
         );
         if let (Some(stiffening), Some(k_g)) = (

@@ -427,7 +427,7 @@ impl IterationMatrix {
     fn active_nonlinear(&mut self, body: &Body) -> Option<&mut NonlinearForceCorrection> {
         self.nonlinear
             .as_mut()
-            .filter(|_| body.options.nonlinear_forces)
+            .filter(|_| body.options.nonlinear_forces && body.single_frame())
     }
 
     /// Freezes the `f_nl` Jacobian of the Woodbury correction over the step at the predictor
