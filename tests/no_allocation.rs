@@ -29,6 +29,41 @@ fn do_step_does_not_allocate_after_the_first_step() {
     // model.auto (the default) with both terms allowed: the indicators run every step.
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.stiffening", 2.0)]);
     pinned_radau_steps_do_not_allocate();
+    controlled_steps_do_not_allocate();
+}
+
+/// The time error control (`model.accuracy`, default): once the rung has settled, a step with
+/// its estimates (the filtered solve, the deformation scale) allocates nothing; a change of
+/// rung is a log message (and, on a rung not seen before, a factorization).
+fn controlled_steps_do_not_allocate() {
+    let mut s = initialized_default(&[
+        ("tip.force[2]", -10.0),
+        ("damping.beta", 1e-4),
+        ("model.accuracy", 1e-2),
+    ]);
+    let tip = vr(&s, "tip.position[2]");
+    let h = 2e-3;
+    // Warm-up: the step load rings the mesh; the rung settles as the damping takes the ringing.
+    for k in 0..100 {
+        s.do_step(k as f64 * h, h).unwrap();
+    }
+    s.drain_events().for_each(drop);
+    let region = Region::new(GLOBAL);
+    for k in 100..120 {
+        s.do_step(k as f64 * h, h).unwrap();
+        s.get_real(tip).unwrap();
+    }
+    let stats = region.change();
+    assert_eq!(
+        s.drain_events().count(),
+        0,
+        "the rung did not settle in the warm-up"
+    );
+    assert_eq!(
+        stats.allocations + stats.reallocations,
+        0,
+        "allocations in 20 controlled steps: {stats:?}"
+    );
 }
 
 /// Radau with a pin: the stage multipliers and both Schur complements (real and complex).
