@@ -284,7 +284,7 @@ fn slabs_that_do_not_converge_are_refused() {
     }
     let tried = log
         .iter()
-        .filter(|m| m.contains("slabs) from now on"))
+        .filter(|m| m.contains("per element layer) from now on"))
         .count();
     let refused = log
         .iter()

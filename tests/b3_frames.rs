@@ -93,10 +93,12 @@ fn exact_gradient_model_converges_to_full_as_the_frames_shrink() {
 #[test]
 fn model_auto_takes_slabs_once_b3_bends_far() {
     // The defaults (model.auto, model.accuracy = 1e-2): the single frame's error estimate
-    // 4 ‖∇ū‖² passes the accuracy during the spin-up (B3's ‖∇ū‖ peaks at 0.061 near 6.7 s) and
-    // the body takes 10 slabs for the rest of the run, once; over 20 s it stays closer to `full`
-    // than the one frame does (measured on the 40-element example body: 0.87 % against 1.57 %
-    // of the peak).
+    // 4 ‖∇ū‖² passes a quarter of the accuracy early in the spin-up (B3's ‖∇ū‖ peaks at 0.061
+    // near 6.7 s; it passes 0.025 at 3.1 s) and the body takes one slab per element layer for
+    // the rest of the run, once; over 20 s it follows `full` within the 0.5 % of the
+    // peak at every communication point (measured: 0.10 % here on 20 elements, against 1.58 %
+    // for one frame; 0.24 % on the 40-element example body against full at a quarter of the
+    // step, bench/results).
     let end = 20.0;
     let (full, _, _) = run_until(&[("model.formulation", 2.0)], end);
     let (one, _, _) = run_until(&[("model.accuracy", 0.0)], end);
@@ -120,5 +122,5 @@ fn model_auto_takes_slabs_once_b3_bends_far() {
         100.0 * e_auto
     );
     assert!(e_auto < e_one, "{e_auto} against {e_one}");
-    assert!(e_auto < 1e-2, "{e_auto}");
+    assert!(e_auto < 5e-3, "{e_auto}");
 }

@@ -60,6 +60,30 @@ pub struct PatchScratch {
     pub rotations: Vec<Matrix3<f64>>,
 }
 
+/// The body's principal axis of least inertia (its longest direction): the eigenvector of the
+/// largest eigenvalue of the nodes' mass-weighted second moment about their centroid
+/// (`lumped_masses`, kg, positive).
+fn principal_axis(mesh: &Mesh, lumped_masses: &[f64]) -> Vector3<f64> {
+    let nodes = mesh.nodes();
+    let total: f64 = lumped_masses.iter().sum();
+    let centre: Vector3<f64> = nodes
+        .iter()
+        .zip(lumped_masses)
+        .map(|(p, &w)| w * Vector3::from(*p))
+        .sum::<Vector3<f64>>()
+        / total;
+    let mut second_moment = Matrix3::zeros();
+    for (p, &w) in nodes.iter().zip(lumped_masses) {
+        let d = Vector3::from(*p) - centre;
+        second_moment += w * d * d.transpose();
+    }
+    let eigen = SymmetricEigen::new(second_moment);
+    eigen
+        .eigenvectors
+        .column(eigen.eigenvalues.imax())
+        .into_owned()
+}
+
 impl Patches {
     /// Splits the elements of `mesh` into `count` slabs of equal length along the body's
     /// principal axis of least inertia (its longest direction), by element centroid; empty slabs
@@ -78,23 +102,7 @@ impl Patches {
             ));
         }
         let nodes = mesh.nodes();
-        let total: f64 = lumped_masses.iter().sum();
-        let centre: Vector3<f64> = nodes
-            .iter()
-            .zip(lumped_masses)
-            .map(|(p, &w)| w * Vector3::from(*p))
-            .sum::<Vector3<f64>>()
-            / total;
-        let mut second_moment = Matrix3::zeros();
-        for (p, &w) in nodes.iter().zip(lumped_masses) {
-            let d = Vector3::from(*p) - centre;
-            second_moment += w * d * d.transpose();
-        }
-        let eigen = SymmetricEigen::new(second_moment);
-        let axis = eigen
-            .eigenvectors
-            .column(eigen.eigenvalues.imax())
-            .into_owned();
+        let axis = principal_axis(mesh, lumped_masses);
         let centroids: Vec<f64> = (0..mesh.element_count())
             .map(|e| {
                 let el = mesh.element(e);
@@ -114,6 +122,36 @@ impl Patches {
         }
         groups.retain(|g| !g.is_empty());
         Self::from_groups(mesh, material, lumped_masses, groups)
+    }
+
+    /// The number of element layers along the body's principal axis of least inertia (as in
+    /// [`Patches::along_principal_axis`]): the nodes' extent along the axis over the elements'
+    /// mean extent along it, rounded, at least 1. On a structured beam mesh of `n` elements
+    /// along its length it is `n`: slabs of one layer each, the finest the mesh allows.
+    pub fn element_layers(mesh: &Mesh, lumped_masses: &[f64]) -> usize {
+        let axis = principal_axis(mesh, lumped_masses);
+        let nodes = mesh.nodes();
+        let along = |n: usize| Vector3::from(nodes[n]).dot(&axis);
+        let extent = |it: &mut dyn Iterator<Item = f64>| {
+            let (lo, hi) = it.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s), hi.max(s))
+            });
+            (hi - lo).max(0.0)
+        };
+        let body = extent(&mut (0..nodes.len()).map(along));
+        let elements = mesh.element_count();
+        if elements == 0 {
+            return 1;
+        }
+        let mean = (0..elements)
+            .map(|e| extent(&mut mesh.element(e).iter().map(|&n| along(n))))
+            .sum::<f64>()
+            / elements as f64;
+        if mean > 0.0 {
+            ((body / mean).round() as usize).clamp(1, elements)
+        } else {
+            1
+        }
     }
 
     /// Patches from groups of elements (each element in exactly one group).
@@ -251,6 +289,19 @@ mod tests {
         let material = IsotropicMaterial::STEEL;
         let lumped = fem::lumped_masses(&mesh, material.density);
         (mesh, material, lumped)
+    }
+
+    #[test]
+    fn a_structured_beam_has_one_layer_per_element_along_it_and_one_slab_per_layer() {
+        let (mesh, material, lumped) = beam();
+        assert_eq!(Patches::element_layers(&mesh, &lumped), 6);
+        let slabs = Patches::along_principal_axis(&mesh, &material, &lumped, 6).unwrap();
+        assert_eq!(slabs.len(), 6);
+        assert!(slabs.patches.iter().all(|p| p.elements.len() == 1));
+        // Across the beam (2 × 3 elements in the section) the layers still run along it.
+        let mesh = generator::beam(2.0, 0.1, 0.1, [8, 2, 3], ElementKind::Hex20).unwrap();
+        let lumped = fem::lumped_masses(&mesh, material.density);
+        assert_eq!(Patches::element_layers(&mesh, &lumped), 8);
     }
 
     #[test]
