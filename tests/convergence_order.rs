@@ -95,6 +95,7 @@ fn initial_state(c: &Cantilever) -> DynamicState {
         acceleration: vec![0.0; n3],
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
+        step_size: 0.0,
     }
 }
 
@@ -312,6 +313,11 @@ fn steps_from(
     let mut ws = StepWorkspace::new(&c.body, &c.free);
     let mut forces = ResidualWorkspace::new(&c.body);
     let mut state = start.clone();
+    // The step from the state as it is: not carried over from the start's own step size
+    // (`generalized_alpha::change_step`, which shifts the velocities by `c_v (h'² − h²) ⃛x`, a
+    // third-order change of the step's position: with it the coarse step's error is 0.58 of
+    // the estimate at h = 4e-4 s, ρ∞ = 0.9).
+    state.step_size = 0.0;
     let settings = IterationSettings {
         absolute_tolerance: 1e-14,
         max_iterations: 50,

@@ -83,6 +83,7 @@ fn run_from(
         acceleration: vec![0.0; n3],
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
+        step_size: 0.0,
     };
     let loads = |t: f64, _x: &[f64], out: &mut [f64]| {
         if !pulse {

@@ -60,6 +60,7 @@ impl Slave {
             acceleration: vec![0.0; 3 * n],
             pseudo_acceleration: vec![0.0; 3 * n],
             multipliers: vec![0.0; model.free.multiplier_count()],
+            step_size: 0.0,
         };
         body.place_rigidly(
             &placement.origin,

@@ -15,7 +15,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64 |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -29,7 +29,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 5;
+pub const PAYLOAD_FORMAT: u32 = 6;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -208,6 +208,7 @@ impl SlaveState {
                 w.f64s(&d.quiet_since);
                 w.u32(d.step_level);
                 w.f64(d.deformation_scale);
+                w.f64(s.step_size);
             }
         }
     }
@@ -397,6 +398,12 @@ impl Slave {
                         "the serialized FMU state holds a negative deformation scale {deformation_scale}"
                     )));
                 }
+                let step_size = r.f64("the last internal step's length")?;
+                if !(step_size.is_finite() && step_size >= 0.0) {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state holds {step_size} for the last internal step's length: not finite and at least 0"
+                    )));
+                }
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -406,6 +413,7 @@ impl Slave {
                         acceleration,
                         pseudo_acceleration,
                         multipliers: lambda,
+                        step_size,
                     },
                     loads,
                     gravity,

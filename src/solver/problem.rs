@@ -122,6 +122,10 @@ pub struct DynamicState {
     /// Lagrange multipliers of the point constraints (N, global; 3 per constraint): the
     /// constraint load on the body is `−Cᵀλ`.
     pub multipliers: Vec<f64>,
+    /// The length of the generalized-α step that produced this state (s); 0 when no step did
+    /// (initialization). A step of another length first carries the state over to it
+    /// (`generalized_alpha::change_step`).
+    pub step_size: f64,
 }
 
 impl DynamicState {
@@ -134,6 +138,7 @@ impl DynamicState {
             acceleration: vec![0.0; dofs],
             pseudo_acceleration: vec![0.0; dofs],
             multipliers: vec![0.0; multipliers],
+            step_size: 0.0,
         }
     }
 
@@ -146,6 +151,7 @@ impl DynamicState {
         self.pseudo_acceleration
             .copy_from_slice(&other.pseudo_acceleration);
         self.multipliers.copy_from_slice(&other.multipliers);
+        self.step_size = other.step_size;
     }
 }
 
