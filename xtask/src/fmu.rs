@@ -2,7 +2,8 @@
 //!
 //! ```text
 //! modelDescription.xml                           from `flexbody-model-description --body FILE`
-//! binaries/<platform>/<modelIdentifier>.<ext>    the release cdylib, renamed (linux64: .so)
+//! binaries/<platform>/<modelIdentifier>.<ext>    the release cdylib of each platform, renamed
+//!                                                (linux64: .so, win64: .dll)
 //! resources/body.json                            the body file, byte for byte
 //! resources/<mesh file>                          a Gmsh mesh the body file names ("mesh":
 //!                                                { "gmsh": { "file": ... } }), at the same
@@ -16,12 +17,211 @@ use crate::{Result, Workspace};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
 /// The package and binary names the build produces.
 const LIBRARY_PACKAGE: &str = "flexbody";
 const DESCRIPTION_BINARY: &str = "flexbody-model-description";
+
+/// A folder of `binaries/` (FMI 2.0 section 2.3): its name, the library extension and the Rust
+/// target that builds it (`None`: the machine's own).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Platform {
+    pub folder: &'static str,
+    pub extension: &'static str,
+    pub rust_target: Option<&'static str>,
+}
+
+/// 64-bit Windows, cross-built with the `x86_64-pc-windows-gnu` target and Debian's MinGW-w64
+/// linker: the DLL links the C runtime statically and imports only Windows' own DLLs
+/// ([`check_windows_imports`]).
+pub const WIN64: Platform = Platform {
+    folder: "win64",
+    extension: "dll",
+    rust_target: Some("x86_64-pc-windows-gnu"),
+};
+
+/// The MinGW-w64 linker and tools for [`WIN64`] (Debian package `gcc-mingw-w64-x86-64`).
+const MINGW_GCC: &str = "x86_64-w64-mingw32-gcc";
+const MINGW_OBJDUMP: &str = "x86_64-w64-mingw32-objdump";
+const MINGW_PACKAGE: &str = "gcc-mingw-w64-x86-64";
+
+/// The platforms of a `--platforms` list (`linux64,win64`): the machine's own folder and `win64`.
+pub fn platforms(list: &str) -> Result<Vec<Platform>> {
+    let host = host_platform()?;
+    let mut chosen = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        let platform = if name == host.folder {
+            host
+        } else if name == WIN64.folder {
+            WIN64
+        } else {
+            return Err(format!(
+                "platform '{name}': this machine builds {} and {} (macOS needs Apple's SDK, which it does not have)",
+                host.folder, WIN64.folder
+            ));
+        };
+        if !chosen.contains(&platform) {
+            chosen.push(platform);
+        }
+    }
+    if chosen.is_empty() {
+        return Err("--platforms names no platform".into());
+    }
+    Ok(chosen)
+}
+
+/// The release cdylib of a cross `platform` (`cargo build --release -p flexbody --lib --target
+/// ...`), after making sure the Rust target and its linker are there: `rustup target add` runs
+/// by itself; the MinGW-w64 linker is installed with apt-get when this runs as root (CI, a fresh
+/// machine), otherwise the error says what to install.
+pub fn build_cross_library(workspace: &Workspace, platform: Platform) -> Result<PathBuf> {
+    let target = platform
+        .rust_target
+        .ok_or("the machine's own platform is built by build_release")?;
+    ensure_rust_target(target)?;
+    ensure_mingw()?;
+    println!("xtask fmu: cargo build --release -p {LIBRARY_PACKAGE} --lib --target {target}");
+    let messages = crate::output(
+        workspace
+            .cargo()
+            .args([
+                "build",
+                "--release",
+                "-p",
+                LIBRARY_PACKAGE,
+                "--lib",
+                "--target",
+                target,
+                "--message-format=json-render-diagnostics",
+            ])
+            .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", MINGW_GCC),
+    )?;
+    cdylib_from_messages(&messages, &format!(".{}", platform.extension))?
+        .ok_or_else(|| format!("cargo reported no cdylib for {LIBRARY_PACKAGE} on {target}"))
+}
+
+/// `rustup target add target` unless `rustup target list --installed` has it.
+fn ensure_rust_target(target: &str) -> Result<()> {
+    let installed = crate::output(Command::new("rustup").args(["target", "list", "--installed"]))
+        .map_err(|e| format!("{e} (the {target} target needs rustup)"))?;
+    if installed.lines().any(|l| l.trim() == target) {
+        return Ok(());
+    }
+    println!("xtask fmu: rustup target add {target}");
+    crate::run(Command::new("rustup").args(["target", "add", target]))
+}
+
+/// The MinGW-w64 linker on PATH, installed with apt-get if missing and this runs as root.
+fn ensure_mingw() -> Result<()> {
+    let present = || {
+        Command::new(MINGW_GCC)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if present() {
+        return Ok(());
+    }
+    let root = crate::output(Command::new("id").arg("-u")).is_ok_and(|u| u.trim() == "0");
+    if root && Path::new("/usr/bin/apt-get").exists() {
+        println!("xtask fmu: apt-get install -y {MINGW_PACKAGE} (the linker of the win64 binary)");
+        crate::run(Command::new("apt-get").args(["update", "-qq"]))?;
+        crate::run(
+            Command::new("apt-get")
+                .args(["install", "-y", "-qq", MINGW_PACKAGE])
+                .env("DEBIAN_FRONTEND", "noninteractive"),
+        )?;
+        if present() {
+            return Ok(());
+        }
+    }
+    Err(format!(
+        "the win64 binary needs the MinGW-w64 linker {MINGW_GCC}: install Debian's {MINGW_PACKAGE} (apt-get install {MINGW_PACKAGE}), or build this machine's platform only with --platforms {}",
+        host_platform().map_or("linux64", |p| p.folder)
+    ))
+}
+
+/// Windows' own DLLs, which every Windows 10 and later has: the only imports a win64 binary of
+/// the FMU may have (lower case; `api-ms-win-*` are the API sets).
+const WINDOWS_SYSTEM_DLLS: &[&str] = &[
+    "kernel32.dll",
+    "ntdll.dll",
+    "msvcrt.dll",
+    "userenv.dll",
+    "ws2_32.dll",
+    "advapi32.dll",
+    "bcrypt.dll",
+    "bcryptprimitives.dll",
+];
+
+/// The DLLs a win64 `dll` imports (`x86_64-w64-mingw32-objdump -p`); an error naming any that
+/// is not one of Windows' own, which an importer's machine would not have.
+pub fn check_windows_imports(dll: &Path) -> Result<Vec<String>> {
+    let dump = crate::output(Command::new(MINGW_OBJDUMP).arg("-p").arg(dll))?;
+    let imports = imported_dlls(&dump);
+    let foreign: Vec<&String> = imports
+        .iter()
+        .filter(|name| !is_windows_system_dll(name))
+        .collect();
+    if !foreign.is_empty() {
+        return Err(format!(
+            "{} imports {foreign:?}, which are not Windows' own DLLs: an importer's machine would not load it",
+            dll.display()
+        ));
+    }
+    Ok(imports)
+}
+
+/// Checks that a win64 `dll` exports the same `fmi2*` functions as this machine's `library`
+/// (`objdump -p`'s export table against `nm -D --defined-only`); returns their number.
+pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
+    let dump = crate::output(Command::new(MINGW_OBJDUMP).arg("-p").arg(dll))?;
+    let mut windows: Vec<String> = dump
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix('['))
+        .filter_map(|l| l.split_once(']'))
+        .map(|(_, name)| name.trim().to_string())
+        .filter(|name| name.starts_with("fmi2"))
+        .collect();
+    let symbols = crate::output(
+        Command::new("nm")
+            .args(["-D", "--defined-only"])
+            .arg(library),
+    )?;
+    let mut host: Vec<String> = symbols
+        .lines()
+        .filter_map(|l| l.split_whitespace().last())
+        .filter(|name| name.starts_with("fmi2"))
+        .map(str::to_string)
+        .collect();
+    windows.sort();
+    windows.dedup();
+    host.sort();
+    if windows != host || host.is_empty() {
+        return Err(format!(
+            "{} exports {windows:?}, {} exports {host:?}: the two binaries of the .fmu must export the same fmi2 functions",
+            dll.display(),
+            library.display()
+        ));
+    }
+    Ok(host.len())
+}
+
+/// The `DLL Name:` entries of an `objdump -p` listing.
+fn imported_dlls(dump: &str) -> Vec<String> {
+    dump.lines()
+        .filter_map(|l| l.trim().strip_prefix("DLL Name:"))
+        .map(|name| name.trim().to_string())
+        .collect()
+}
+
+fn is_windows_system_dll(name: &str) -> bool {
+    let lower = name.to_ascii_lowercase();
+    lower.starts_with("api-ms-win-") || WINDOWS_SYSTEM_DLLS.contains(&lower.as_str())
+}
 
 /// The release artifacts an FMU is made of.
 pub struct Artifacts {
@@ -61,14 +261,7 @@ fn artifacts_from_messages(messages: &str) -> Result<Artifacts> {
         let kinds = target["kind"].as_array().cloned().unwrap_or_default();
         let is_kind = |kind: &str| kinds.iter().any(|k| k == kind);
         if target["name"] == LIBRARY_PACKAGE && is_kind("cdylib") {
-            let suffix = std::env::consts::DLL_SUFFIX;
-            library = message["filenames"]
-                .as_array()
-                .into_iter()
-                .flatten()
-                .filter_map(|f| f.as_str())
-                .find(|f| f.ends_with(suffix))
-                .map(PathBuf::from);
+            library = library_file(&message, std::env::consts::DLL_SUFFIX);
         } else if target["name"] == DESCRIPTION_BINARY && is_kind("bin") {
             description_binary = message["executable"].as_str().map(PathBuf::from);
         }
@@ -80,10 +273,39 @@ fn artifacts_from_messages(messages: &str) -> Result<Artifacts> {
     })
 }
 
-/// Generates the description for `body` and writes the `.fmu`; returns its path.
+/// The file ending in `suffix` among a `compiler-artifact` message's filenames.
+fn library_file(message: &serde_json::Value, suffix: &str) -> Option<PathBuf> {
+    message["filenames"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|f| f.as_str())
+        .find(|f| f.ends_with(suffix))
+        .map(PathBuf::from)
+}
+
+/// The flexbody cdylib ending in `suffix` in cargo's messages, if any.
+fn cdylib_from_messages(messages: &str, suffix: &str) -> Result<Option<PathBuf>> {
+    for line in messages.lines().filter(|l| l.starts_with('{')) {
+        let message: serde_json::Value =
+            serde_json::from_str(line).map_err(|e| format!("cargo message {line}: {e}"))?;
+        let target = &message["target"];
+        let cdylib = target["kind"]
+            .as_array()
+            .is_some_and(|kinds| kinds.iter().any(|k| k == "cdylib"));
+        if message["reason"] == "compiler-artifact" && target["name"] == LIBRARY_PACKAGE && cdylib {
+            return Ok(library_file(&message, suffix));
+        }
+    }
+    Ok(None)
+}
+
+/// Generates the description for `body` and writes the `.fmu` with the host's library and
+/// the cross-built `others` (platform, library); returns its path.
 pub fn package(
     workspace: &Workspace,
     artifacts: &Artifacts,
+    others: &[(Platform, PathBuf)],
     body: &Path,
     out: Option<&Path>,
 ) -> Result<PathBuf> {
@@ -103,11 +325,13 @@ pub fn package(
             .join("fmu")
             .join(format!("{}.fmu", file_stem(&body_name(&body_text)?))),
     };
+    let mut libraries = vec![(host_platform()?, artifacts.library.clone())];
+    libraries.extend(others.iter().cloned());
     write_fmu(
         &out,
         &xml,
         &model_identifier,
-        &artifacts.library,
+        &libraries,
         body_text.as_bytes(),
         &resources,
     )?;
@@ -148,16 +372,21 @@ fn mesh_resources(body_json: &str, body_dir: &Path) -> Result<Vec<(String, Vec<u
 }
 
 /// The FMI platform folder and library extension of the machine this xtask was built for.
-fn platform() -> Result<(&'static str, &'static str)> {
+pub fn host_platform() -> Result<Platform> {
     if cfg!(not(target_pointer_width = "64")) {
         return Err("only 64-bit platforms are packaged".into());
     }
-    match std::env::consts::OS {
-        "linux" => Ok(("linux64", "so")),
-        "macos" => Ok(("darwin64", "dylib")),
-        "windows" => Ok(("win64", "dll")),
-        os => Err(format!("FMI 2.0 defines no binaries folder for {os}")),
-    }
+    let (folder, extension) = match std::env::consts::OS {
+        "linux" => ("linux64", "so"),
+        "macos" => ("darwin64", "dylib"),
+        "windows" => ("win64", "dll"),
+        os => return Err(format!("FMI 2.0 defines no binaries folder for {os}")),
+    };
+    Ok(Platform {
+        folder,
+        extension,
+        rust_target: None,
+    })
 }
 
 /// Writes the archive next to `out` and renames it into place, so a failed run leaves no
@@ -166,27 +395,33 @@ fn write_fmu(
     out: &Path,
     xml: &str,
     model_identifier: &str,
-    library: &Path,
+    libraries: &[(Platform, PathBuf)],
     body_json: &[u8],
     resources: &[(String, Vec<u8>)],
 ) -> Result<()> {
-    let (platform, extension) = platform()?;
-    let library_bytes =
-        std::fs::read(library).map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+    let mut binaries = Vec::new();
+    for (platform, library) in libraries {
+        let bytes = std::fs::read(library)
+            .map_err(|e| format!("cannot read {}: {e}", library.display()))?;
+        binaries.push((
+            format!(
+                "binaries/{}/{model_identifier}.{}",
+                platform.folder, platform.extension
+            ),
+            bytes,
+        ));
+    }
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     }
     let partial = out.with_extension("fmu.partial");
-    let mut entries: Vec<(String, &[u8], u32)> = vec![
-        ("modelDescription.xml".into(), xml.as_bytes(), 0o644),
-        (
-            format!("binaries/{platform}/{model_identifier}.{extension}"),
-            &library_bytes,
-            0o755,
-        ),
-        ("resources/body.json".into(), body_json, 0o644),
-    ];
+    let mut entries: Vec<(String, &[u8], u32)> =
+        vec![("modelDescription.xml".into(), xml.as_bytes(), 0o644)];
+    for (name, bytes) in &binaries {
+        entries.push((name.clone(), bytes, 0o755));
+    }
+    entries.push(("resources/body.json".into(), body_json, 0o644));
     for (name, bytes) in resources {
         entries.push((name.clone(), bytes, 0o644));
     }
@@ -340,6 +575,36 @@ mod tests {
             .contains("cannot read"));
     }
 
+    #[test]
+    fn imports_are_read_from_objdump_and_foreign_dlls_are_named() {
+        let dump = "\tDLL Name: KERNEL32.dll\n\tvma:  Hint/Ord Member-Name\n\tDLL Name: api-ms-win-core-synch-l1-2-0.dll\n\tDLL Name: libgcc_s_seh-1.dll\n";
+        let imports = imported_dlls(dump);
+        assert_eq!(
+            imports,
+            [
+                "KERNEL32.dll",
+                "api-ms-win-core-synch-l1-2-0.dll",
+                "libgcc_s_seh-1.dll"
+            ]
+        );
+        let foreign: Vec<&String> = imports
+            .iter()
+            .filter(|n| !is_windows_system_dll(n))
+            .collect();
+        assert_eq!(foreign, ["libgcc_s_seh-1.dll"]);
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn platform_lists_name_this_machine_and_win64() {
+        assert_eq!(
+            platforms("linux64, win64,linux64").unwrap(),
+            [host_platform().unwrap(), WIN64]
+        );
+        assert!(platforms("darwin64").unwrap_err().contains("SDK"));
+        assert!(platforms("").is_err());
+    }
+
     #[cfg(target_os = "linux")]
     #[test]
     fn fmu_has_the_fmi_layout() {
@@ -347,13 +612,15 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let library = dir.join("libflexbody.so");
         std::fs::write(&library, b"\x7fELF not really").unwrap();
+        let dll = dir.join("flexbody.dll");
+        std::fs::write(&dll, b"MZ not really").unwrap();
         let out = dir.join("out").join("cantilever.fmu");
         let xml = r#"<fmiModelDescription><CoSimulation modelIdentifier="flexbody"/></fmiModelDescription>"#;
         write_fmu(
             &out,
             xml,
             "flexbody",
-            &library,
+            &[(host_platform().unwrap(), library), (WIN64, dll)],
             b"{\"name\":\"cantilever\"}",
             &[("resources/meshes/part.msh".into(), b"$MeshFormat".to_vec())],
         )
@@ -367,6 +634,7 @@ mod tests {
             names,
             [
                 "binaries/linux64/flexbody.so",
+                "binaries/win64/flexbody.dll",
                 "modelDescription.xml",
                 "resources/body.json",
                 "resources/meshes/part.msh"
@@ -382,6 +650,7 @@ mod tests {
         let (library_bytes, mode) = read("binaries/linux64/flexbody.so");
         assert_eq!(library_bytes, b"\x7fELF not really");
         assert_eq!(mode.map(|m| m & 0o777), Some(0o755));
+        assert_eq!(read("binaries/win64/flexbody.dll").0, b"MZ not really");
         assert_eq!(read("resources/body.json").0, b"{\"name\":\"cantilever\"}");
         assert_eq!(read("resources/meshes/part.msh").0, b"$MeshFormat");
         std::fs::remove_dir_all(&dir).unwrap();

@@ -1,10 +1,12 @@
 //! The project's tasks, run as `cargo xtask <task>` (alias in `.cargo/config.toml`):
 //!
-//! * `fmu [--body FILE] [--out FILE]`: builds the release library and the description binary and
-//!   packages `modelDescription.xml`, `binaries/<platform>/<modelIdentifier>.<ext>` and
-//!   `resources/body.json` into an FMI 2.0 `.fmu` (default: `<target>/fmu/<body name>.fmu`).
+//! * `fmu [--body FILE] [--out FILE] [--platforms LIST]`: builds the release library (for each
+//!   platform: this machine's and, by default, win64 cross-built with MinGW-w64) and the
+//!   description binary and packages `modelDescription.xml`,
+//!   `binaries/<platform>/<modelIdentifier>.<ext>` and `resources/body.json` into an FMI 2.0
+//!   `.fmu` (default: `<target>/fmu/<body name>.fmu`).
 //! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), then the
-//!   default FMU, the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
+//!   default FMU (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
 //!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
 //!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU` and `FLEXBODY_CONROD_FMU` (`examples/conrod.json`).
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
@@ -32,8 +34,12 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-  fmu [--body FILE] [--out FILE]    build the .fmu (default body: examples/cantilever.json,
-                                    default out: <target>/fmu/<body name>.fmu)
+  fmu [--body FILE] [--out FILE] [--platforms LIST]
+                                    build the .fmu (default body: examples/cantilever.json,
+                                    default out: <target>/fmu/<body name>.fmu, default
+                                    platforms: linux64,win64; win64 is cross-built with the
+                                    x86_64-pc-windows-gnu target, which rustup adds, and
+                                    Debian's gcc-mingw-w64-x86-64, installed when run as root)
   test [--python-only] [ARGS...]    cargo test --workspace, build the default and the driven
                                     cantilever's .fmu, set up the pinned venv (<target>/venv)
                                     and run pytest tests/python
@@ -80,15 +86,26 @@ fn main() -> ExitCode {
     }
 }
 
-/// `cargo xtask fmu [--body FILE] [--out FILE]`.
+/// The platforms of the `.fmu` unless `--platforms` says otherwise.
+const DEFAULT_PLATFORMS: &str = "linux64,win64";
+
+/// `cargo xtask fmu [--body FILE] [--out FILE] [--platforms LIST]`.
 fn fmu_task(args: &[String]) -> Result<()> {
     let mut body = None;
     let mut out = None;
+    let mut platforms = fmu::platforms(DEFAULT_PLATFORMS)?;
     let mut args = args.iter();
     while let Some(arg) = args.next() {
         let slot = match arg.as_str() {
             "--body" => &mut body,
             "--out" => &mut out,
+            "--platforms" => {
+                let list = args
+                    .next()
+                    .ok_or("--platforms needs a list (linux64,win64)")?;
+                platforms = fmu::platforms(list)?;
+                continue;
+            }
             other => return Err(format!("unexpected argument '{other}'\n{USAGE}")),
         };
         let value = args
@@ -98,7 +115,7 @@ fn fmu_task(args: &[String]) -> Result<()> {
         *slot = Some(std::path::absolute(value).map_err(|e| format!("{value}: {e}"))?);
     }
     let workspace = Workspace::locate()?;
-    workspace.build_fmu(body.as_deref(), out.as_deref())?;
+    workspace.build_fmu(body.as_deref(), out.as_deref(), &platforms)?;
     Ok(())
 }
 
@@ -115,10 +132,18 @@ fn test_task(args: &[String]) -> Result<()> {
         println!("xtask test: Rust tests (cargo test --workspace)");
         run(workspace.cargo().args(["test", "--workspace"]))?;
     }
-    let fmu = workspace.build_fmu(None, None)?;
-    // The second release build is a no-op: only the packaging differs.
-    let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None)?;
-    let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None)?;
+    let fmu = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?)?;
+    let dll = workspace.cross_library(fmu::WIN64)?;
+    let imports = fmu::check_windows_imports(&dll)?;
+    let exports = fmu::check_windows_exports(&dll, &fmu::build_release(&workspace)?.library)?;
+    println!(
+        "xtask test: the win64 DLL exports the {exports} fmi2 functions of the linux64 library, unmangled, and imports only Windows' own DLLs: {}",
+        imports.join(", ")
+    );
+    // The other release builds are no-ops: only the packaging differs.
+    let host = [fmu::host_platform()?];
+    let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None, &host)?;
+    let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None, &host)?;
     let python = venv::ensure(&workspace)?;
     println!(
         "xtask test: Python tests (pytest tests/python) on {} and {}",
@@ -143,7 +168,8 @@ fn demo_task(args: &[String]) -> Result<()> {
         return Err(format!("unexpected argument '{arg}'\n{USAGE}"));
     }
     let workspace = Workspace::locate()?;
-    let fmu = workspace.build_fmu(None, None)?;
+    // The demo runs here: this machine's binary is all it needs.
+    let fmu = workspace.build_fmu(None, None, &[fmu::host_platform()?])?;
     let python = venv::ensure(&workspace)?;
     let plot = workspace.target_dir.join("demo").join("cantilever.png");
     let mut demo = Command::new(&python);
@@ -232,11 +258,25 @@ impl Workspace {
         self.root.join("examples").join("conrod.json")
     }
 
-    /// Builds and packages the FMU; returns its path.
-    fn build_fmu(&self, body: Option<&Path>, out: Option<&Path>) -> Result<PathBuf> {
+    /// The release library of a cross `platform` (built if needed).
+    fn cross_library(&self, platform: fmu::Platform) -> Result<PathBuf> {
+        fmu::build_cross_library(self, platform)
+    }
+
+    /// Builds and packages the FMU with the binaries of `platforms`; returns its path.
+    fn build_fmu(
+        &self,
+        body: Option<&Path>,
+        out: Option<&Path>,
+        platforms: &[fmu::Platform],
+    ) -> Result<PathBuf> {
         let body = body.map_or_else(|| self.default_body(), Path::to_path_buf);
         let artifacts = fmu::build_release(self)?;
-        let package = fmu::package(self, &artifacts, &body, out)?;
+        let mut others = Vec::new();
+        for &platform in platforms.iter().filter(|p| p.rust_target.is_some()) {
+            others.push((platform, self.cross_library(platform)?));
+        }
+        let package = fmu::package(self, &artifacts, &others, &body, out)?;
         let size = std::fs::metadata(&package)
             .map_err(|e| format!("{}: {e}", package.display()))?
             .len();
