@@ -192,23 +192,14 @@ fn main() {
     } else {
         &[1e-2, 1e-3, 1e-4]
     };
-    let mut rows = Vec::new();
-    for &accuracy in accuracies {
-        let r = timed(repeats, || {
+    let rows = controlled_rows(accuracies, &reference, |accuracy| {
+        timed(repeats, || {
             b1(
                 &[("solver.stepSize", top), ("model.accuracy", accuracy)],
                 end,
             )
-        });
-        let e = relative_error(&r.samples, &reference);
-        println!(
-            "| model.accuracy = {accuracy:e} | {} | {} | {:.1} | {e:.3e} |",
-            r.steps,
-            r.redone,
-            r.wall * 1e3
-        );
-        rows.push((accuracy, r.wall, e));
-    }
+        })
+    });
     println!(
         "\n| model.accuracy | error / peak | within? | wall (ms) | cheapest fixed step with at most that error | its wall (ms) | ours / it | interpolated fixed wall (ms) | ours / interpolated |"
     );
@@ -297,18 +288,9 @@ fn main() {
             hand.push((label, r.wall, e));
         }
     }
-    let mut controlled = Vec::new();
-    for &accuracy in &[1e-2, 1e-3] {
-        let r = b3(&[("model.accuracy", accuracy)], end, 1e-2);
-        let e = relative_error(&r.samples, &reference);
-        println!(
-            "| model.accuracy = {accuracy:e} | {} | {} | {:.1} | {e:.3e} |",
-            r.steps,
-            r.redone,
-            r.wall * 1e3
-        );
-        controlled.push((accuracy, r.wall, e));
-    }
+    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
+        b3(&[("model.accuracy", accuracy)], end, 1e-2)
+    });
     compare_with_hand_chosen(&controlled, &hand);
 
     // ---- the connecting rod --------------------------------------------------------------------
@@ -334,19 +316,31 @@ fn main() {
         );
         hand.push((label, r.wall, e));
     }
-    let mut controlled = Vec::new();
-    for &accuracy in &[1e-2, 1e-3] {
-        let r = conrod(&[("model.accuracy", accuracy)], end);
-        let e = relative_error(&r.samples, &reference);
+    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
+        conrod(&[("model.accuracy", accuracy)], end)
+    });
+    compare_with_hand_chosen(&controlled, &hand);
+}
+
+/// A row per accuracy: `run(accuracy)` against `reference`; returns `(accuracy, wall, error)`.
+fn controlled_rows(
+    accuracies: &[f64],
+    reference: &[f64],
+    run: impl Fn(f64) -> Run,
+) -> Vec<(f64, f64, f64)> {
+    let mut rows = Vec::new();
+    for &accuracy in accuracies {
+        let r = run(accuracy);
+        let e = relative_error(&r.samples, reference);
         println!(
             "| model.accuracy = {accuracy:e} | {} | {} | {:.1} | {e:.3e} |",
             r.steps,
             r.redone,
             r.wall * 1e3
         );
-        controlled.push((accuracy, r.wall, e));
+        rows.push((accuracy, r.wall, e));
     }
-    compare_with_hand_chosen(&controlled, &hand);
+    rows
 }
 
 /// The table of the controlled runs `(accuracy, wall, error)` against the cheapest hand-chosen
