@@ -2,9 +2,12 @@
 //! not reach the physics (`src/slave/`): strings, signatures, rejected instantiations, NULL
 //! arguments. Tests with a working slave are in `tests/fmi2_slave.rs`.
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod fmi2_support;

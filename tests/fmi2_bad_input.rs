@@ -3,9 +3,12 @@
 //! with a logger message that names the variable (or function), the value and the reason; the
 //! instance stays usable and nothing of a rejected call is kept.
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod fmi2_support;

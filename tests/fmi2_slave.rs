@@ -5,9 +5,12 @@
 //! Body: the embedded default (B1 cantilever, interfaces `root` (fixed, value references
 //! 1000..) and `tip` (force, 1100..)).
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod fmi2_support;

@@ -5,8 +5,9 @@
 //! plain `extern "C"` function with the one variadic argument this crate passes (the `"%s"`
 //! text) as a sixth parameter, cast to the variadic type. On the System V x86-64 and AArch64
 //! Linux ABIs a variadic call passes its first integer/pointer arguments in the same registers
-//! as a non-variadic one, so the callee reads them correctly; the tests are compiled for those
-//! targets only.
+//! as a non-variadic one, and on Windows x64 in the same registers and stack slots, so the
+//! callee reads them correctly; the tests are compiled for those targets only (Windows: cross-built
+//! and run under wine by `cargo xtask test`).
 
 #![allow(dead_code, non_snake_case)]
 

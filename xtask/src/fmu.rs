@@ -144,6 +144,63 @@ fn ensure_mingw() -> Result<()> {
     ))
 }
 
+/// The Rust target and the MinGW-w64 linker of [`WIN64`], set up as [`build_cross_library`]
+/// does (for building its tests).
+pub fn ensure_windows_toolchain() -> Result<()> {
+    ensure_rust_target(WIN64.rust_target.expect("win64 is a cross target"))?;
+    ensure_mingw()
+}
+
+/// The environment variable that names the linker of [`WIN64`] for cargo, and its value.
+pub const WINDOWS_LINKER: (&str, &str) = ("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", MINGW_GCC);
+
+/// wine's 64-bit loader (Debian: `/usr/lib/wine/wine64`, not on PATH), installed with apt-get
+/// (Debian's `wine` and `wine64`) if missing and this runs as root.
+pub fn ensure_wine64() -> Result<PathBuf> {
+    let find = || {
+        ["/usr/lib/wine/wine64", "/usr/bin/wine64"]
+            .iter()
+            .map(PathBuf::from)
+            .find(|p| p.exists())
+    };
+    if let Some(path) = find() {
+        return Ok(path);
+    }
+    let root = crate::output(Command::new("id").arg("-u")).is_ok_and(|u| u.trim() == "0");
+    if root && Path::new("/usr/bin/apt-get").exists() {
+        println!("xtask test: apt-get install -y wine wine64 (to run the win64 tests)");
+        crate::run(Command::new("apt-get").args(["update", "-qq"]))?;
+        crate::run(
+            Command::new("apt-get")
+                .args(["install", "-y", "-qq", "wine", "wine64"])
+                .env("DEBIAN_FRONTEND", "noninteractive"),
+        )?;
+        if let Some(path) = find() {
+            return Ok(path);
+        }
+    }
+    Err("the win64 tests run under wine: install Debian's wine and wine64 (apt-get install wine wine64)".into())
+}
+
+/// Builds the wine-only stand-in for `bcryptprimitives.dll` (`tests/wine/`) as
+/// `dir/bcryptprimitives.dll`, beside the executables that need it under wine.
+pub fn build_wine_stand_in(workspace: &Workspace, dir: &Path) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let dll = dir.join("bcryptprimitives.dll");
+    crate::run(
+        Command::new(MINGW_GCC)
+            .args(["-shared", "-O2", "-o"])
+            .arg(&dll)
+            .arg(
+                workspace
+                    .root
+                    .join("tests/wine/bcryptprimitives_stand_in.c"),
+            )
+            .arg("-ladvapi32"),
+    )?;
+    Ok(dll)
+}
+
 /// Windows' own DLLs, which every Windows 10 and later has: the only imports a win64 binary of
 /// the FMU may have (lower case; `api-ms-win-*` are the API sets).
 const WINDOWS_SYSTEM_DLLS: &[&str] = &[

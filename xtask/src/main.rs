@@ -5,8 +5,9 @@
 //!   description binary and packages `modelDescription.xml`,
 //!   `binaries/<platform>/<modelIdentifier>.<ext>` and `resources/body.json` into an FMI 2.0
 //!   `.fmu` (default: `<target>/fmu/<body name>.fmu`).
-//! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), then the
-//!   default FMU (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
+//! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), the
+//!   C-ABI and slave tests cross-built for win64 and run under wine, then the default FMU
+//!   (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
 //!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
 //!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU` and `FLEXBODY_CONROD_FMU` (`examples/conrod.json`).
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
@@ -131,6 +132,7 @@ fn test_task(args: &[String]) -> Result<()> {
     if !python_only {
         println!("xtask test: Rust tests (cargo test --workspace)");
         run(workspace.cargo().args(["test", "--workspace"]))?;
+        windows_tests(&workspace)?;
     }
     let fmu = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?)?;
     let dll = workspace.cross_library(fmu::WIN64)?;
@@ -160,6 +162,58 @@ fn test_task(args: &[String]) -> Result<()> {
         .env("FLEXBODY_CONROD_FMU", &conrod_fmu)
         .env("MPLBACKEND", "Agg");
     run(&mut pytest)
+}
+
+/// The tests of the C ABI and the slave that a Windows importer depends on
+/// (`tests/fmi2_abi.rs`, `fmi2_slave.rs`, `fmi2_bad_input.rs`), cross-built for win64 and run
+/// under wine, with the wine-only stand-in for `bcryptprimitives.dll` beside them. Their output
+/// goes to `<target>/wine/tests.log`, printed afterwards: a wineserver left running would hold a
+/// pipe open and keep the caller waiting; it is stopped at the end.
+fn windows_tests(workspace: &Workspace) -> Result<()> {
+    const TESTS: [&str; 3] = ["fmi2_abi", "fmi2_slave", "fmi2_bad_input"];
+    let target = fmu::WIN64.rust_target.expect("win64 is a cross target");
+    fmu::ensure_windows_toolchain()?;
+    let wine64 = fmu::ensure_wine64()?;
+    println!(
+        "xtask test: the C-ABI and slave tests for win64 under wine ({})",
+        TESTS.join(", ")
+    );
+    let deps = workspace.target_dir.join(target).join("debug").join("deps");
+    fmu::build_wine_stand_in(workspace, &deps)?;
+    let log_path = workspace.target_dir.join("wine").join("tests.log");
+    std::fs::create_dir_all(log_path.parent().unwrap())
+        .map_err(|e| format!("cannot create {}: {e}", log_path.display()))?;
+    let log = std::fs::File::create(&log_path)
+        .map_err(|e| format!("cannot create {}: {e}", log_path.display()))?;
+    let mut cargo = workspace.cargo();
+    cargo
+        .args(["test", "--target", target])
+        .args(TESTS.iter().flat_map(|t| ["--test", t]))
+        .env(fmu::WINDOWS_LINKER.0, fmu::WINDOWS_LINKER.1)
+        .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUNNER", &wine64)
+        .env("WINEDEBUG", "-all")
+        .stdin(std::process::Stdio::null())
+        .stdout(log.try_clone().map_err(|e| e.to_string())?)
+        .stderr(log);
+    let result = run(&mut cargo);
+    let wineserver = wine64.with_file_name("wineserver");
+    if wineserver.exists() {
+        let _ = Command::new(&wineserver)
+            .arg("-k")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .status();
+    }
+    let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+    for line in text.lines().filter(|l| {
+        l.starts_with("test ")
+            || l.contains("Running")
+            || l.contains("error")
+            || l.contains("panicked")
+    }) {
+        println!("  {line}");
+    }
+    result.map_err(|e| format!("{e} (the whole output is in {})", log_path.display()))
 }
 
 /// `cargo xtask demo`.
