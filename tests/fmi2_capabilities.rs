@@ -4,9 +4,12 @@
 //!
 //! Body: the embedded default (B1 cantilever: `root` fixed, `tip` force interface).
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod common;
@@ -248,7 +251,7 @@ fn damaged_or_foreign_serialized_states_are_refused_by_name() {
         Some("other body"),
         fmi2CoSimulation,
         Some(&other_guid),
-        Some(&format!("file://{}", dir.display())),
+        Some(&file_uri(&dir)),
         Some(&functions),
         false,
     );

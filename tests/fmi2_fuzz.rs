@@ -9,9 +9,12 @@
 //! `FLEXBODY_FUZZ_SEED`). The run is bounded in time, `FLEXBODY_FUZZ_SECONDS` (default 15 s; the
 //! calls tried are printed), so CI stays fast; longer runs search deeper.
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod fmi2_support;

@@ -1,9 +1,12 @@
 //! Many instances in one process, stepped from different threads at the same time, give bit for
 //! bit the results they give when stepped alone (no global state, no shared scratch).
 
-#![cfg(all(
-    target_os = "linux",
-    any(target_arch = "x86_64", target_arch = "aarch64")
+#![cfg(any(
+    all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ),
+    all(target_os = "windows", target_arch = "x86_64")
 ))]
 
 mod fmi2_support;

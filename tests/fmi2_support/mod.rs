@@ -16,6 +16,21 @@ use flexbody::fmi2::types::*;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::sync::Mutex;
 
+/// The `file:` URI of a local directory as importers pass it: `file:///tmp/x` on Linux,
+/// `file:///C:/Users/x` on Windows (forward slashes), spaces percent-encoded.
+pub fn file_uri(dir: &std::path::Path) -> String {
+    let path = dir
+        .to_str()
+        .expect("a UTF-8 path")
+        .replace('\\', "/")
+        .replace(' ', "%20");
+    if path.starts_with('/') {
+        format!("file://{path}")
+    } else {
+        format!("file:///{path}")
+    }
+}
+
 /// One recorded logger call.
 #[derive(Debug, Clone)]
 pub struct Message {
