@@ -6,7 +6,7 @@
 //!   `binaries/<platform>/<modelIdentifier>.<ext>` and `resources/body.json` into an FMI 2.0
 //!   `.fmu` (default: `<target>/fmu/<body name>.fmu`).
 //! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), the
-//!   C-ABI tests (`tests/fmi2_*.rs`) cross-built for win64 and run under wine, then the default FMU
+//!   library's Rust tests cross-built for win64 and run under wine, then the default FMU
 //!   (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
 //!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
 //!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU` and `FLEXBODY_CONROD_FMU` (`examples/conrod.json`).
@@ -164,27 +164,17 @@ fn test_task(args: &[String]) -> Result<()> {
     run(&mut pytest)
 }
 
-/// The tests of the C ABI that a Windows importer depends on (`tests/fmi2_*.rs`: signatures,
-/// the slave through the ABI, bad input, capabilities and FMU states, fuzzing, threads),
-/// cross-built for win64 and run
-/// under wine, with the wine-only stand-in for `bcryptprimitives.dll` beside them. Their output
-/// goes to `<target>/wine/tests.log`, printed afterwards: a wineserver left running would hold a
-/// pipe open and keep the caller waiting; it is stopped at the end.
+/// The library's Rust tests (unit and integration: the C ABI, the slave, the physics),
+/// cross-built for win64 and run under wine, with the wine-only stand-in for
+/// `bcryptprimitives.dll` beside them. Their output goes to `<target>/wine/tests.log` and the
+/// summary lines are printed afterwards: a wineserver left running would hold a pipe open and
+/// keep the caller waiting; it is stopped at the end.
 fn windows_tests(workspace: &Workspace) -> Result<()> {
-    const TESTS: [&str; 6] = [
-        "fmi2_abi",
-        "fmi2_slave",
-        "fmi2_bad_input",
-        "fmi2_capabilities",
-        "fmi2_fuzz",
-        "fmi2_threads",
-    ];
     let target = fmu::WIN64.rust_target.expect("win64 is a cross target");
     fmu::ensure_windows_toolchain()?;
     let wine64 = fmu::ensure_wine64()?;
     println!(
-        "xtask test: the C-ABI and slave tests for win64 under wine ({})",
-        TESTS.join(", ")
+        "xtask test: the Rust tests for win64 under wine (cargo test --target {target} --tests)"
     );
     let deps = workspace.target_dir.join(target).join("debug").join("deps");
     fmu::build_wine_stand_in(workspace, &deps)?;
@@ -195,8 +185,7 @@ fn windows_tests(workspace: &Workspace) -> Result<()> {
         .map_err(|e| format!("cannot create {}: {e}", log_path.display()))?;
     let mut cargo = workspace.cargo();
     cargo
-        .args(["test", "--target", target])
-        .args(TESTS.iter().flat_map(|t| ["--test", t]))
+        .args(["test", "--no-fail-fast", "--target", target, "--tests"])
         .env(fmu::WINDOWS_LINKER.0, fmu::WINDOWS_LINKER.1)
         .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUNNER", &wine64)
         .env("WINEDEBUG", "-all")
