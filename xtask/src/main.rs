@@ -202,11 +202,13 @@ fn windows_tests(workspace: &Workspace) -> Result<()> {
             .status();
     }
     let text = std::fs::read_to_string(&log_path).unwrap_or_default();
+    // The summary: each binary, its result, and whatever failed.
     for line in text.lines().filter(|l| {
-        l.starts_with("test ")
-            || l.contains("Running")
-            || l.contains("error")
+        l.contains("Running")
+            || l.starts_with("test result")
+            || l.contains("FAILED")
             || l.contains("panicked")
+            || l.starts_with("error")
     }) {
         println!("  {line}");
     }
