@@ -125,23 +125,32 @@ fn ensure_mingw() -> Result<()> {
     if present() {
         return Ok(());
     }
-    let root = crate::output(Command::new("id").arg("-u")).is_ok_and(|u| u.trim() == "0");
-    if root && Path::new("/usr/bin/apt-get").exists() {
-        println!("xtask fmu: apt-get install -y {MINGW_PACKAGE} (the linker of the win64 binary)");
-        crate::run(Command::new("apt-get").args(["update", "-qq"]))?;
-        crate::run(
-            Command::new("apt-get")
-                .args(["install", "-y", "-qq", MINGW_PACKAGE])
-                .env("DEBIAN_FRONTEND", "noninteractive"),
-        )?;
-        if present() {
-            return Ok(());
-        }
+    if apt_install_as_root(&[MINGW_PACKAGE], "the linker of the win64 binary")? && present() {
+        return Ok(());
     }
     Err(format!(
         "the win64 binary needs the MinGW-w64 linker {MINGW_GCC}: install Debian's {MINGW_PACKAGE} (apt-get install {MINGW_PACKAGE}), or build this machine's platform only with --platforms {}",
         host_platform().map_or("linux64", |p| p.folder)
     ))
+}
+
+/// Installs Debian `packages` with apt-get when this runs as root on a Debian-like system (CI, a
+/// fresh machine), saying `why`; `Ok(false)` when it cannot (the caller then says what to
+/// install).
+fn apt_install_as_root(packages: &[&str], why: &str) -> Result<bool> {
+    let root = crate::output(Command::new("id").arg("-u")).is_ok_and(|u| u.trim() == "0");
+    if !root || !Path::new("/usr/bin/apt-get").exists() {
+        return Ok(false);
+    }
+    println!("xtask: apt-get install -y {} ({why})", packages.join(" "));
+    crate::run(Command::new("apt-get").args(["update", "-qq"]))?;
+    crate::run(
+        Command::new("apt-get")
+            .args(["install", "-y", "-qq"])
+            .args(packages)
+            .env("DEBIAN_FRONTEND", "noninteractive"),
+    )?;
+    Ok(true)
 }
 
 /// The Rust target and the MinGW-w64 linker of [`WIN64`], set up as [`build_cross_library`]
@@ -166,15 +175,7 @@ pub fn ensure_wine64() -> Result<PathBuf> {
     if let Some(path) = find() {
         return Ok(path);
     }
-    let root = crate::output(Command::new("id").arg("-u")).is_ok_and(|u| u.trim() == "0");
-    if root && Path::new("/usr/bin/apt-get").exists() {
-        println!("xtask test: apt-get install -y wine wine64 (to run the win64 tests)");
-        crate::run(Command::new("apt-get").args(["update", "-qq"]))?;
-        crate::run(
-            Command::new("apt-get")
-                .args(["install", "-y", "-qq", "wine", "wine64"])
-                .env("DEBIAN_FRONTEND", "noninteractive"),
-        )?;
+    if apt_install_as_root(&["wine", "wine64"], "to run the win64 tests")? {
         if let Some(path) = find() {
             return Ok(path);
         }
