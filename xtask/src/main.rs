@@ -135,7 +135,7 @@ fn test_task(args: &[String]) -> Result<()> {
         windows_tests(&workspace)?;
     }
     let fmu = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?)?;
-    let dll = workspace.cross_library(fmu::WIN64)?;
+    let dll = fmu::build_cross_library(&workspace, fmu::WIN64)?;
     let imports = fmu::check_windows_imports(&dll)?;
     let exports = fmu::check_windows_exports(&dll, &fmu::build_release(&workspace)?.library)?;
     println!(
@@ -311,11 +311,6 @@ impl Workspace {
         self.root.join("examples").join("conrod.json")
     }
 
-    /// The release library of a cross `platform` (built if needed).
-    fn cross_library(&self, platform: fmu::Platform) -> Result<PathBuf> {
-        fmu::build_cross_library(self, platform)
-    }
-
     /// Builds and packages the FMU with the binaries of `platforms`; returns its path.
     fn build_fmu(
         &self,
@@ -327,7 +322,7 @@ impl Workspace {
         let artifacts = fmu::build_release(self)?;
         let mut others = Vec::new();
         for &platform in platforms.iter().filter(|p| p.rust_target.is_some()) {
-            others.push((platform, self.cross_library(platform)?));
+            others.push((platform, fmu::build_cross_library(self, platform)?));
         }
         let package = fmu::package(self, &artifacts, &others, &body, out)?;
         let size = std::fs::metadata(&package)
