@@ -17,6 +17,7 @@ const FLOORS: &[&[&str]] = &[
     &["model"],
     &["slave"],
     &["fmi2"],
+    &["fmi3"],
 ];
 
 fn floor_of(module: &str) -> Option<usize> {

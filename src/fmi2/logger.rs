@@ -46,6 +46,40 @@ pub struct Logger {
     instance_name: CString,
     /// `enabled[i]` for `LOG_CATEGORIES[i]`.
     enabled: Vec<bool>,
+    /// The instance answers to FMI 3.0: messages name FMI 3.0's functions and states.
+    fmi3: bool,
+}
+
+/// FMI 2.0 names in the messages of [`crate::fmi2::Instance`] and their FMI 3.0 counterparts,
+/// longest first; any other `fmi2` prefix becomes `fmi3`.
+const FMI3_NAMES: [(&str, &str); 15] = [
+    ("fmi2GetRealOutputDerivatives", "fmi3GetOutputDerivatives"),
+    ("fmi2SerializedFMUstateSize", "fmi3SerializedFMUStateSize"),
+    ("fmi2DeSerializeFMUstate", "fmi3DeserializeFMUState"),
+    ("fmi2SerializeFMUstate", "fmi3SerializeFMUState"),
+    ("fmi2SetupExperiment", "fmi3EnterInitializationMode"),
+    ("fmi2Instantiate", "fmi3InstantiateCoSimulation"),
+    ("fmi2FreeFMUstate", "fmi3FreeFMUState"),
+    ("fmi2GetFMUstate", "fmi3GetFMUState"),
+    ("fmi2SetFMUstate", "fmi3SetFMUState"),
+    ("fmi2GetReal", "fmi3GetFloat64"),
+    ("fmi2SetReal", "fmi3SetFloat64"),
+    ("this FMU's GUID", "this FMU's instantiationToken"),
+    ("fmuGUID", "instantiationToken"),
+    ("StepComplete", "StepMode"),
+    ("StepFailed", "StepDiscarded"),
+];
+
+/// `message` with FMI 2.0's function and state names replaced by FMI 3.0's (FMI 3.0 section
+/// 4.2.1: Step Mode and Step Discarded are FMI 2.0's StepComplete and StepFailed).
+pub fn fmi3_names(message: &str) -> String {
+    let mut text = message.to_string();
+    for (fmi2, fmi3) in FMI3_NAMES {
+        if text.contains(fmi2) {
+            text = text.replace(fmi2, fmi3);
+        }
+    }
+    text.replace("fmi2", "fmi3")
 }
 
 impl Logger {
@@ -55,7 +89,15 @@ impl Logger {
             sink,
             instance_name: to_c_string(instance_name),
             enabled: vec![logging_on; LOG_CATEGORIES.len()],
+            fmi3: false,
         }
+    }
+
+    /// This logger for an FMI 3.0 instance: its messages name FMI 3.0's functions and states
+    /// ([`fmi3_names`]).
+    pub fn for_fmi3(mut self) -> Logger {
+        self.fmi3 = true;
+        self
     }
 
     /// The instance name as passed to the callback (a copy owned by this logger).
@@ -115,6 +157,13 @@ impl Logger {
         if !self.is_enabled(category) {
             return;
         }
+        let translated;
+        let message = if self.fmi3 {
+            translated = fmi3_names(message);
+            translated.as_str()
+        } else {
+            message
+        };
         match &mut self.sink {
             Sink::None => {}
             Sink::Rust(f) => f(status, category, message),
@@ -235,6 +284,22 @@ mod tests {
         ] {
             assert!(names.contains(&c), "{c} is not in LOG_CATEGORIES");
         }
+    }
+
+    #[test]
+    fn an_fmi3_logger_names_fmi3_functions_and_states() {
+        let (logger, log) = capture(false);
+        let mut logger = logger.for_fmi3();
+        logger.error("fmi2DoStep: not allowed in state StepFailed (allowed in: StepComplete)");
+        logger.error("fmi2GetFMUstate, fmi2GetRealOutputDerivatives, fmi2Discard");
+        assert_eq!(
+            log.borrow()[0].2,
+            "fmi3DoStep: not allowed in state StepDiscarded (allowed in: StepMode)"
+        );
+        assert_eq!(
+            log.borrow()[1].2,
+            "fmi3GetFMUState, fmi3GetOutputDerivatives, fmi3Discard"
+        );
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The model as the importer sees it: the body file (serde), the variable table with its value
 //! references, and the generated `modelDescription.xml`.
 
+pub mod arrays;
 pub mod body_file;
 pub mod enumerations;
 pub mod model_description;

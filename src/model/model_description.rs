@@ -116,44 +116,7 @@ pub fn model_description(
         a(MODEL_IDENTIFIER)
     );
 
-    // Units: those used, in the order of UNITS; a used unit missing from UNITS is still declared
-    // (without base units) so that every `unit` attribute refers to a declared unit.
-    let used: Vec<&str> = {
-        let mut u: Vec<&str> = Vec::new();
-        for v in table.iter() {
-            if let Some(name) = v.unit {
-                if !u.contains(&name) {
-                    u.push(name);
-                }
-            }
-        }
-        u
-    };
-    if !used.is_empty() {
-        x.push_str("  <UnitDefinitions>\n");
-        for unit in UNITS.iter().filter(|u| used.contains(&u.name)) {
-            let mut base = String::new();
-            for (attr, e) in [
-                ("kg", unit.kg),
-                ("m", unit.m),
-                ("s", unit.s),
-                ("rad", unit.rad),
-            ] {
-                if e != 0 {
-                    let _ = write!(base, " {attr}=\"{e}\"");
-                }
-            }
-            let _ = writeln!(
-                x,
-                "    <Unit name=\"{}\">\n      <BaseUnit{base}/>\n    </Unit>",
-                a(unit.name)
-            );
-        }
-        for name in used.iter().filter(|n| !UNITS.iter().any(|u| u.name == **n)) {
-            let _ = writeln!(x, "    <Unit name=\"{}\"/>", a(name));
-        }
-        x.push_str("  </UnitDefinitions>\n");
-    }
+    unit_definitions(&mut x, table);
 
     // Enumeration types used by the variables, in the order of ENUMERATIONS.
     let declared: Vec<&str> = table.iter().filter_map(|v| v.declared_type).collect();
@@ -180,18 +143,7 @@ pub fn model_description(
         x.push_str("  </TypeDefinitions>\n");
     }
 
-    if !LOG_CATEGORIES.is_empty() {
-        x.push_str("  <LogCategories>\n");
-        for (name, description) in LOG_CATEGORIES {
-            let _ = writeln!(
-                x,
-                "    <Category name=\"{}\" description=\"{}\"/>",
-                a(name),
-                a(description)
-            );
-        }
-        x.push_str("  </LogCategories>\n");
-    }
+    log_categories(&mut x);
 
     let _ = writeln!(
         x,
@@ -284,6 +236,68 @@ pub fn model_description(
     x.push_str("</fmiModelDescription>\n");
     x
 }
+
+/// `<UnitDefinitions>`: the units the variables use, in the order of `UNITS`; a used unit missing
+/// from `UNITS` is still declared (without base units) so that every `unit` attribute refers to a
+/// declared unit. The same element in FMI 2.0 and 3.0.
+fn unit_definitions(x: &mut String, table: &VariableTable) {
+    let a = escape_attribute;
+    let used: Vec<&str> = {
+        let mut u: Vec<&str> = Vec::new();
+        for v in table.iter() {
+            if let Some(name) = v.unit {
+                if !u.contains(&name) {
+                    u.push(name);
+                }
+            }
+        }
+        u
+    };
+    if !used.is_empty() {
+        x.push_str("  <UnitDefinitions>\n");
+        for unit in UNITS.iter().filter(|u| used.contains(&u.name)) {
+            let mut base = String::new();
+            for (attr, e) in [
+                ("kg", unit.kg),
+                ("m", unit.m),
+                ("s", unit.s),
+                ("rad", unit.rad),
+            ] {
+                if e != 0 {
+                    let _ = write!(base, " {attr}=\"{e}\"");
+                }
+            }
+            let _ = writeln!(
+                x,
+                "    <Unit name=\"{}\">\n      <BaseUnit{base}/>\n    </Unit>",
+                a(unit.name)
+            );
+        }
+        for name in used.iter().filter(|n| !UNITS.iter().any(|u| u.name == **n)) {
+            let _ = writeln!(x, "    <Unit name=\"{}\"/>", a(name));
+        }
+        x.push_str("  </UnitDefinitions>\n");
+    }
+}
+
+/// `<LogCategories>`: the same element in FMI 2.0 and 3.0.
+fn log_categories(x: &mut String) {
+    let a = escape_attribute;
+    if !LOG_CATEGORIES.is_empty() {
+        x.push_str("  <LogCategories>\n");
+        for (name, description) in LOG_CATEGORIES {
+            let _ = writeln!(
+                x,
+                "    <Category name=\"{}\" description=\"{}\"/>",
+                a(name),
+                a(description)
+            );
+        }
+        x.push_str("  </LogCategories>\n");
+    }
+}
+
+pub mod fmi3;
 
 #[cfg(test)]
 mod tests;

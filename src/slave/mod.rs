@@ -7,6 +7,7 @@ use crate::body::Body;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::model::category;
+use crate::model::model_description::fmi3::model_description_fmi3;
 use crate::model::model_description::{model_description, ModelInfo};
 use crate::model::variables::FIXED_TABLE_FINGERPRINT;
 use crate::model::{BodyFile, Target, Variable, VariableTable, VariableType};
@@ -520,16 +521,30 @@ impl Slave {
         Ok(())
     }
 
-    /// The complete `modelDescription.xml` of this body.
-    pub fn model_description(&self) -> String {
-        let info = ModelInfo {
+    /// What the model description says about the model besides its variables.
+    fn model_info(&self) -> ModelInfo {
+        ModelInfo {
             model_name: self.body_file.name.clone(),
             description: self.body_file.description.clone(),
             guid: self.guid.clone(),
             generation_tool: format!("flexbody {}", env!("CARGO_PKG_VERSION")),
             default_step_size: self.defaults.step_size,
-        };
-        model_description(&self.variables, &info, &|v: &Variable| self.start_value(v))
+        }
+    }
+
+    /// The complete FMI 2.0 `modelDescription.xml` of this body.
+    pub fn model_description(&self) -> String {
+        model_description(&self.variables, &self.model_info(), &|v: &Variable| {
+            self.start_value(v)
+        })
+    }
+
+    /// The complete FMI 3.0 `modelDescription.xml` of this body (the same variables, see
+    /// [`crate::model::model_description::fmi3`]).
+    pub fn model_description_fmi3(&self) -> String {
+        model_description_fmi3(&self.variables, &self.model_info(), &|v: &Variable| {
+            self.start_value(v)
+        })
     }
 }
 

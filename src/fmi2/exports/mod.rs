@@ -30,7 +30,7 @@ pub type Component = Instance<Slave>;
 pub type FmuState = Snapshot<SlaveState>;
 
 /// The text of a panic payload.
-fn panic_text(payload: &(dyn Any + Send)) -> String {
+pub(crate) fn panic_text(payload: &(dyn Any + Send)) -> String {
     if let Some(s) = payload.downcast_ref::<&str>() {
         (*s).to_string()
     } else if let Some(s) = payload.downcast_ref::<String>() {
@@ -62,7 +62,7 @@ unsafe fn call(
 }
 
 /// `n` elements at `p`; an empty slice for `n == 0` (whatever `p`), None for NULL with `n > 0`.
-unsafe fn slice_in<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
+pub(crate) unsafe fn slice_in<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
     if n == 0 {
         Some(&[])
     } else if p.is_null() {
@@ -73,7 +73,7 @@ unsafe fn slice_in<'a, T>(p: *const T, n: usize) -> Option<&'a [T]> {
 }
 
 /// Mutable counterpart of [`slice_in`].
-unsafe fn slice_out<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
+pub(crate) unsafe fn slice_out<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
     if n == 0 {
         Some(&mut [])
     } else if p.is_null() {
@@ -84,7 +84,7 @@ unsafe fn slice_out<'a, T>(p: *mut T, n: usize) -> Option<&'a mut [T]> {
 }
 
 /// A copy of a C string (lossy UTF-8); None for NULL.
-unsafe fn copy_string(p: fmi2String) -> Option<String> {
+pub(crate) unsafe fn copy_string(p: fmi2String) -> Option<String> {
     if p.is_null() {
         None
     } else {
@@ -240,29 +240,45 @@ fn instantiate(
             }
         },
     };
-    let slave = match catch_unwind(|| Slave::from_resources(resource_dir.as_deref())) {
+    let Some(slave) = load_slave(F, &name, &guid, resource_dir.as_deref(), &mut logger) else {
+        return null_mut();
+    };
+    logger.event(&format!("{F}: instance {name} created"));
+    Box::into_raw(Box::new(Instance::new(slave, logger))) as fmi2Component
+}
+
+/// The slave of a new instance (FMI 2.0 and 3.0): the body from `resource_dir` (the embedded
+/// default body when None), checked against the importer's GUID (`instantiationToken`); None
+/// after a logged message.
+pub(crate) fn load_slave(
+    function: &str,
+    name: &str,
+    guid: &str,
+    resource_dir: Option<&std::path::Path>,
+    logger: &mut Logger,
+) -> Option<Slave> {
+    let slave = match catch_unwind(|| Slave::from_resources(resource_dir)) {
         Ok(Ok(slave)) => slave,
         Ok(Err(e)) => {
-            logger.error(&format!("{F}: {name}: {}", e.message));
-            return null_mut();
+            logger.error(&format!("{function}: {name}: {}", e.message));
+            return None;
         }
         Err(payload) => {
             logger.error(&format!(
-                "{F}: {name}: internal error (panic) while loading the body: {}",
+                "{function}: {name}: internal error (panic) while loading the body: {}",
                 panic_text(payload.as_ref())
             ));
-            return null_mut();
+            return None;
         }
     };
     if slave.guid() != guid {
         logger.error(&format!(
-            "{F}: {name}: fmuGUID {guid} does not match this FMU's GUID {} (modelDescription.xml and binary or body.json are from different builds)",
+            "{function}: {name}: fmuGUID {guid} does not match this FMU's GUID {} (modelDescription.xml and binary or body.json are from different builds)",
             slave.guid()
         ));
-        return null_mut();
+        return None;
     }
-    logger.event(&format!("{F}: instance {name} created"));
-    Box::into_raw(Box::new(Instance::new(slave, logger))) as fmi2Component
+    Some(slave)
 }
 
 /// `fmi2FreeInstance`: NULL is a no-op.

@@ -10,16 +10,23 @@ pub unsafe extern "C" fn fmi2GetFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const F: &str = "fmi2GetFMUstate";
-    call(c, F, |inst| {
-        if FMUstate.is_null() {
-            return inst.fail(F, "FMUstate is NULL");
-        }
-        let snapshot = match inst.snapshot(F) {
-            Ok(s) => s,
-            Err(status) => return status,
-        };
-        store_state(inst, F, FMUstate, snapshot)
-    })
+    call(c, F, |inst| get_fmu_state(inst, F, FMUstate))
+}
+
+/// The body of [`fmi2GetFMUstate`] (also FMI 3.0's).
+pub(crate) unsafe fn get_fmu_state(
+    inst: &mut Component,
+    F: &str,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    if FMUstate.is_null() {
+        return inst.fail(F, "FMUstate is NULL");
+    }
+    let snapshot = match inst.snapshot(F) {
+        Ok(s) => s,
+        Err(status) => return status,
+    };
+    store_state(inst, F, FMUstate, snapshot)
 }
 
 /// Stores `snapshot` in `*FMUstate` (fmi2GetFMUstate, fmi2DeSerializeFMUstate): a new state when
@@ -49,10 +56,19 @@ unsafe fn store_state(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, FMUstate: fmi2FMUstate) -> fmi2Status {
     const F: &str = "fmi2SetFMUstate";
-    call(c, F, |inst| match (FMUstate as *const FmuState).as_ref() {
+    call(c, F, |inst| set_fmu_state(inst, F, FMUstate))
+}
+
+/// The body of [`fmi2SetFMUstate`] (also FMI 3.0's).
+pub(crate) unsafe fn set_fmu_state(
+    inst: &mut Component,
+    F: &str,
+    FMUstate: fmi2FMUstate,
+) -> fmi2Status {
+    match (FMUstate as *const FmuState).as_ref() {
         Some(snapshot) => inst.restore(snapshot),
         None => inst.fail(F, "FMUstate is NULL"),
-    })
+    }
 }
 
 /// `fmi2FreeFMUstate`: frees `*FMUstate` and sets it to NULL; a NULL state is a no-op.
@@ -62,24 +78,31 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     FMUstate: *mut fmi2FMUstate,
 ) -> fmi2Status {
     const F: &str = "fmi2FreeFMUstate";
-    call(c, F, |inst| {
-        if let Err(status) = inst.may_free_state() {
-            return status;
-        }
-        if FMUstate.is_null() || (*FMUstate).is_null() {
-            return fmi2Status::fmi2OK;
-        }
-        let ptr = *FMUstate as *mut FmuState;
-        if !(*ptr).is_valid() {
-            return inst.fail(
-                F,
-                "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
-            );
-        }
-        drop(Box::from_raw(ptr));
-        *FMUstate = null_mut();
-        fmi2Status::fmi2OK
-    })
+    call(c, F, |inst| free_fmu_state(inst, F, FMUstate))
+}
+
+/// The body of [`fmi2FreeFMUstate`] (also FMI 3.0's).
+pub(crate) unsafe fn free_fmu_state(
+    inst: &mut Component,
+    F: &str,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    if let Err(status) = inst.may_free_state() {
+        return status;
+    }
+    if FMUstate.is_null() || (*FMUstate).is_null() {
+        return fmi2Status::fmi2OK;
+    }
+    let ptr = *FMUstate as *mut FmuState;
+    if !(*ptr).is_valid() {
+        return inst.fail(
+            F,
+            "*FMUstate is not a live state of this FMU (freed, or from another FMU)",
+        );
+    }
+    drop(Box::from_raw(ptr));
+    *FMUstate = null_mut();
+    fmi2Status::fmi2OK
 }
 
 /// The live state behind `FMUstate`, or an error message.
@@ -107,21 +130,31 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
 ) -> fmi2Status {
     const F: &str = "fmi2SerializedFMUstateSize";
     call(c, F, |inst| {
-        if size.is_null() {
-            return inst.fail(F, "size is NULL");
-        }
-        let state = match live_state(inst, F, FMUstate) {
-            Ok(s) => s,
-            Err(status) => return status,
-        };
-        match inst.serialize_snapshot(F, state) {
-            Ok(bytes) => {
-                *size = bytes.len();
-                fmi2Status::fmi2OK
-            }
-            Err(status) => status,
-        }
+        serialized_fmu_state_size(inst, F, FMUstate, size)
     })
+}
+
+/// The body of [`fmi2SerializedFMUstateSize`] (also FMI 3.0's).
+pub(crate) unsafe fn serialized_fmu_state_size(
+    inst: &mut Component,
+    F: &str,
+    FMUstate: fmi2FMUstate,
+    size: *mut usize,
+) -> fmi2Status {
+    if size.is_null() {
+        return inst.fail(F, "size is NULL");
+    }
+    let state = match live_state(inst, F, FMUstate) {
+        Ok(s) => s,
+        Err(status) => return status,
+    };
+    match inst.serialize_snapshot(F, state) {
+        Ok(bytes) => {
+            *size = bytes.len();
+            fmi2Status::fmi2OK
+        }
+        Err(status) => status,
+    }
 }
 
 /// `fmi2SerializeFMUstate`: writes the state's portable bytes (layout:
@@ -136,30 +169,41 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
 ) -> fmi2Status {
     const F: &str = "fmi2SerializeFMUstate";
     call(c, F, |inst| {
-        let state = match live_state(inst, F, FMUstate) {
-            Ok(s) => s,
-            Err(status) => return status,
-        };
-        let bytes = match inst.serialize_snapshot(F, state) {
-            Ok(b) => b,
-            Err(status) => return status,
-        };
-        if size < bytes.len() {
-            return inst.fail(
-                F,
-                &format!(
-                    "size = {size} rejected: the state needs {} bytes (fmi2SerializedFMUstateSize)",
-                    bytes.len()
-                ),
-            );
-        }
-        let Some(out) = slice_out(serializedState as *mut u8, size) else {
-            return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
-        };
-        out[..bytes.len()].copy_from_slice(&bytes);
-        out[bytes.len()..].fill(0);
-        fmi2Status::fmi2OK
+        serialize_fmu_state(inst, F, FMUstate, serializedState, size)
     })
+}
+
+/// The body of [`fmi2SerializeFMUstate`] (also FMI 3.0's).
+pub(crate) unsafe fn serialize_fmu_state(
+    inst: &mut Component,
+    F: &str,
+    FMUstate: fmi2FMUstate,
+    serializedState: *mut fmi2Byte,
+    size: usize,
+) -> fmi2Status {
+    let state = match live_state(inst, F, FMUstate) {
+        Ok(s) => s,
+        Err(status) => return status,
+    };
+    let bytes = match inst.serialize_snapshot(F, state) {
+        Ok(b) => b,
+        Err(status) => return status,
+    };
+    if size < bytes.len() {
+        return inst.fail(
+            F,
+            &format!(
+                "size = {size} rejected: the state needs {} bytes (fmi2SerializedFMUstateSize)",
+                bytes.len()
+            ),
+        );
+    }
+    let Some(out) = slice_out(serializedState as *mut u8, size) else {
+        return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
+    };
+    out[..bytes.len()].copy_from_slice(&bytes);
+    out[bytes.len()..].fill(0);
+    fmi2Status::fmi2OK
 }
 
 /// `fmi2DeSerializeFMUstate`: a state from bytes of `fmi2SerializeFMUstate` (of an instance of
@@ -174,16 +218,27 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
 ) -> fmi2Status {
     const F: &str = "fmi2DeSerializeFMUstate";
     call(c, F, |inst| {
-        if FMUstate.is_null() {
-            return inst.fail(F, "FMUstate is NULL");
-        }
-        let Some(bytes) = slice_in(serializedState as *const u8, size) else {
-            return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
-        };
-        let snapshot = match inst.deserialize_snapshot(bytes) {
-            Ok(s) => s,
-            Err(status) => return status,
-        };
-        store_state(inst, F, FMUstate, snapshot)
+        deserialize_fmu_state(inst, F, serializedState, size, FMUstate)
     })
+}
+
+/// The body of [`fmi2DeSerializeFMUstate`] (also FMI 3.0's).
+pub(crate) unsafe fn deserialize_fmu_state(
+    inst: &mut Component,
+    F: &str,
+    serializedState: *const fmi2Byte,
+    size: usize,
+    FMUstate: *mut fmi2FMUstate,
+) -> fmi2Status {
+    if FMUstate.is_null() {
+        return inst.fail(F, "FMUstate is NULL");
+    }
+    let Some(bytes) = slice_in(serializedState as *const u8, size) else {
+        return inst.fail(F, &format!("serializedState is NULL with size = {size}"));
+    };
+    let snapshot = match inst.deserialize_snapshot(bytes) {
+        Ok(s) => s,
+        Err(status) => return status,
+    };
+    store_state(inst, F, FMUstate, snapshot)
 }

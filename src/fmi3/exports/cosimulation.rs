@@ -1,0 +1,82 @@
+//! The co-simulation functions: `fmi3DoStep`, `fmi3EnterStepMode`, `fmi3GetOutputDerivatives`.
+#![allow(non_snake_case, clippy::missing_safety_doc)]
+
+use super::*;
+
+/// `fmi3DoStep`: one communication step (synchronous, never early). `eventHandlingNeeded` and
+/// `earlyReturn` are false; `terminateSimulation` is true after a discarded step (the slave
+/// rolled back; the importer may restore a state or end); `lastSuccessfulTime` is the slave's
+/// time. The output pointers may be NULL.
+#[no_mangle]
+pub unsafe extern "C" fn fmi3DoStep(
+    instance: fmi3Instance,
+    currentCommunicationPoint: fmi3Float64,
+    communicationStepSize: fmi3Float64,
+    noSetFMUStatePriorToCurrentPoint: fmi3Boolean,
+    eventHandlingNeeded: *mut fmi3Boolean,
+    terminateSimulation: *mut fmi3Boolean,
+    earlyReturn: *mut fmi3Boolean,
+    lastSuccessfulTime: *mut fmi3Float64,
+) -> fmi3Status {
+    let _ = noSetFMUStatePriorToCurrentPoint;
+    call(instance, "fmi3DoStep", |inst| {
+        let (status, terminate) = inst.do_step(currentCommunicationPoint, communicationStepSize);
+        let flag = |b: bool| if b { fmi3True } else { fmi3False };
+        if let Some(p) = eventHandlingNeeded.as_mut() {
+            *p = fmi3False;
+        }
+        if let Some(p) = terminateSimulation.as_mut() {
+            *p = flag(terminate);
+        }
+        if let Some(p) = earlyReturn.as_mut() {
+            *p = fmi3False;
+        }
+        if let Some(p) = lastSuccessfulTime.as_mut() {
+            *p = inst.time();
+        }
+        status
+    })
+}
+
+/// `fmi3EnterStepMode`: only after event mode, which this FMU does not have
+/// (`hasEventMode="false"`: `fmi3ExitInitializationMode` goes to Step Mode directly).
+#[no_mangle]
+pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
+    const F: &str = "fmi3EnterStepMode";
+    call(instance, F, |inst| {
+        inst.fail(
+            F,
+            "not allowed: this FMU has no event mode (hasEventMode=\"false\"); fmi3ExitInitializationMode enters Step Mode",
+        )
+    })
+}
+
+/// `fmi3GetOutputDerivatives` (`maxOutputDerivativeOrder="2"`): `orders[i]` for every element
+/// of `valueReferences[i]`; which outputs have derivatives: see
+/// [`crate::slave::Slave::get_real_output_derivative`].
+#[no_mangle]
+pub unsafe extern "C" fn fmi3GetOutputDerivatives(
+    instance: fmi3Instance,
+    valueReferences: *const fmi3ValueReference,
+    nValueReferences: usize,
+    orders: *const fmi3Int32,
+    values: *mut fmi3Float64,
+    nValues: usize,
+) -> fmi3Status {
+    const F: &str = "fmi3GetOutputDerivatives";
+    call(instance, F, |inst| {
+        match (
+            slice_in(valueReferences, nValueReferences),
+            slice_in(orders, nValueReferences),
+            slice_out(values, nValues),
+        ) {
+            (Some(vrs), Some(orders), Some(values)) => {
+                inst.get_output_derivatives(vrs, orders, values)
+            }
+            _ => inst.fail(
+                F,
+                &format!("valueReferences, orders or values is NULL with nValueReferences = {nValueReferences}, nValues = {nValues}"),
+            ),
+        }
+    })
+}
