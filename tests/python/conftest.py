@@ -1,6 +1,6 @@
 """Fixtures shared by the fmpy tests of the packaged FMUs.
 
-`cargo xtask test` builds the default FMU (``examples/cantilever.json``) and the driven cantilever
+`cargo xtask test` builds the default FMU (``examples/cantilever.json``; also as FMI 3.0, ``FLEXBODY_FMU3``) and the driven cantilever
 (``examples/driven_cantilever.json``, root clamped to an input frame) and passes their paths in
 ``FLEXBODY_FMU`` and ``FLEXBODY_DRIVEN_FMU``; without them the tests look for
 ``target/fmu/cantilever.fmu`` and ``target/fmu/driven_cantilever.fmu`` (what
@@ -68,3 +68,9 @@ def conrod_fmu_path() -> str:
     """The connecting rod: a Gmsh tet10 mesh in resources/, big eye a motion interface, small eye a force
     interface (examples/conrod.json)."""
     return _packaged_fmu("FLEXBODY_CONROD_FMU", "conrod.fmu", "cargo xtask fmu --body examples/conrod.json")
+
+
+@pytest.fixture(scope="session")
+def fmu3_path() -> str:
+    """The default body as an FMI 3.0 FMU (``cargo xtask fmu --fmi 3``)."""
+    return _packaged_fmu("FLEXBODY_FMU3", "cantilever-fmi3.fmu", "cargo xtask fmu --fmi 3")

@@ -1,9 +1,12 @@
-//! Building and packaging the `.fmu`: a zip archive (FMI 2.0 section 2.3) with
+//! Building and packaging the `.fmu`: a zip archive (FMI 2.0 section 2.3, FMI 3.0 section 2.5)
+//! with
 //!
 //! ```text
-//! modelDescription.xml                           from `flexbody-model-description --body FILE`
+//! modelDescription.xml                           from `flexbody-model-description --body FILE
+//!                                                [--fmi 3]`
 //! binaries/<platform>/<modelIdentifier>.<ext>    the release cdylib of each platform, renamed
-//!                                                (linux64: .so, win64: .dll)
+//!                                                (linux64: .so, win64: .dll; FMI 3.0's folders
+//!                                                are x86_64-linux and x86_64-windows)
 //! resources/body.json                            the body file, byte for byte
 //! resources/<mesh file>                          a Gmsh mesh the body file names ("mesh":
 //!                                                { "gmsh": { "file": ... } }), at the same
@@ -25,13 +28,26 @@ use zip::{CompressionMethod, ZipWriter};
 const LIBRARY_PACKAGE: &str = "flexbody";
 const DESCRIPTION_BINARY: &str = "flexbody-model-description";
 
-/// A folder of `binaries/` (FMI 2.0 section 2.3): its name, the library extension and the Rust
-/// target that builds it (`None`: the machine's own).
+/// A folder of `binaries/`: its name in FMI 2.0 (section 2.3) and in FMI 3.0 (section 2.5.1.1,
+/// `<arch>-<os>`), the library extension and the Rust target that builds it (`None`: the
+/// machine's own).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Platform {
     pub folder: &'static str,
+    pub fmi3_folder: &'static str,
     pub extension: &'static str,
     pub rust_target: Option<&'static str>,
+}
+
+impl Platform {
+    /// The folder under `binaries/` in an FMU of FMI version `fmi` (2 or 3).
+    pub fn folder_for(&self, fmi: u8) -> &'static str {
+        if fmi == 3 {
+            self.fmi3_folder
+        } else {
+            self.folder
+        }
+    }
 }
 
 /// 64-bit Windows, cross-built with the `x86_64-pc-windows-gnu` target and Debian's MinGW-w64
@@ -39,6 +55,7 @@ pub struct Platform {
 /// ([`check_windows_imports`]).
 pub const WIN64: Platform = Platform {
     folder: "win64",
+    fmi3_folder: "x86_64-windows",
     extension: "dll",
     rust_target: Some("x86_64-pc-windows-gnu"),
 };
@@ -233,8 +250,8 @@ pub fn check_windows_imports(dll: &Path) -> Result<Vec<String>> {
     Ok(imports)
 }
 
-/// Checks that a win64 `dll` exports the same `fmi2*` functions as this machine's `library`
-/// (`objdump -p`'s export table against `nm -D --defined-only`); returns their number.
+/// Checks that a win64 `dll` exports the same `fmi2*` and `fmi3*` functions as this machine's
+/// `library` (`objdump -p`'s export table against `nm -D --defined-only`); returns their number.
 pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
     let dump = crate::output(Command::new(MINGW_OBJDUMP).arg("-p").arg(dll))?;
     let mut windows: Vec<String> = dump
@@ -242,7 +259,7 @@ pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
         .filter_map(|l| l.trim().strip_prefix('['))
         .filter_map(|l| l.split_once(']'))
         .map(|(_, name)| name.trim().to_string())
-        .filter(|name| name.starts_with("fmi2"))
+        .filter(|name| is_fmi_function(name))
         .collect();
     let symbols = crate::output(
         Command::new("nm")
@@ -252,7 +269,7 @@ pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
     let mut host: Vec<String> = symbols
         .lines()
         .filter_map(|l| l.split_whitespace().last())
-        .filter(|name| name.starts_with("fmi2"))
+        .filter(|name| is_fmi_function(name))
         .map(str::to_string)
         .collect();
     windows.sort();
@@ -260,12 +277,16 @@ pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
     host.sort();
     if windows != host || host.is_empty() {
         return Err(format!(
-            "{} exports {windows:?}, {} exports {host:?}: the two binaries of the .fmu must export the same fmi2 functions",
+            "{} exports {windows:?}, {} exports {host:?}: the two binaries of the .fmu must export the same fmi2 and fmi3 functions",
             dll.display(),
             library.display()
         ));
     }
     Ok(host.len())
+}
+
+fn is_fmi_function(name: &str) -> bool {
+    name.starts_with("fmi2") || name.starts_with("fmi3")
 }
 
 /// The `DLL Name:` entries of an `objdump -p` listing.
@@ -358,33 +379,42 @@ fn cdylib_from_messages(messages: &str, suffix: &str) -> Result<Option<PathBuf>>
     Ok(None)
 }
 
-/// Generates the description for `body` and writes the `.fmu` with the host's library and
-/// the cross-built `others` (platform, library); returns its path.
+/// Generates the FMI `fmi` (2 or 3) description for `body` and writes the `.fmu` with the
+/// host's library and the cross-built `others` (platform, library); returns its path (by
+/// default `<target>/fmu/<body name>.fmu`, `<body name>-fmi3.fmu` for FMI 3.0: one archive holds
+/// one `modelDescription.xml`, so one FMI version).
 pub fn package(
     workspace: &Workspace,
     artifacts: &Artifacts,
     others: &[(Platform, PathBuf)],
     body: &Path,
     out: Option<&Path>,
+    fmi: u8,
 ) -> Result<PathBuf> {
     let body_text = std::fs::read_to_string(body)
         .map_err(|e| format!("cannot read {}: {e}", body.display()))?;
     let xml = crate::output(
         std::process::Command::new(&artifacts.description_binary)
             .arg("--body")
-            .arg(body),
+            .arg(body)
+            .args(["--fmi", &fmi.to_string()]),
     )?;
     let model_identifier = model_identifier(&xml)?;
     let resources = mesh_resources(&body_text, body.parent().unwrap_or(Path::new(".")))?;
     let out = match out {
         Some(path) => path.to_path_buf(),
-        None => workspace
-            .target_dir
-            .join("fmu")
-            .join(format!("{}.fmu", file_stem(&body_name(&body_text)?))),
+        None => workspace.target_dir.join("fmu").join(format!(
+            "{}{}.fmu",
+            file_stem(&body_name(&body_text)?),
+            if fmi == 3 { "-fmi3" } else { "" }
+        )),
     };
     let mut libraries = vec![(host_platform()?, artifacts.library.clone())];
     libraries.extend(others.iter().cloned());
+    let libraries: Vec<(&str, &str, PathBuf)> = libraries
+        .into_iter()
+        .map(|(p, library)| (p.folder_for(fmi), p.extension, library))
+        .collect();
     write_fmu(
         &out,
         &xml,
@@ -440,8 +470,17 @@ pub fn host_platform() -> Result<Platform> {
         "windows" => ("win64", "dll"),
         os => return Err(format!("FMI 2.0 defines no binaries folder for {os}")),
     };
+    let fmi3_folder = match (std::env::consts::ARCH, std::env::consts::OS) {
+        ("x86_64", "linux") => "x86_64-linux",
+        ("aarch64", "linux") => "aarch64-linux",
+        ("x86_64", "macos") => "x86_64-darwin",
+        ("aarch64", "macos") => "aarch64-darwin",
+        ("x86_64", "windows") => "x86_64-windows",
+        (arch, os) => return Err(format!("no FMI 3.0 binaries folder for {arch} {os}")),
+    };
     Ok(Platform {
         folder,
+        fmi3_folder,
         extension,
         rust_target: None,
     })
@@ -453,19 +492,16 @@ fn write_fmu(
     out: &Path,
     xml: &str,
     model_identifier: &str,
-    libraries: &[(Platform, PathBuf)],
+    libraries: &[(&str, &str, PathBuf)],
     body_json: &[u8],
     resources: &[(String, Vec<u8>)],
 ) -> Result<()> {
     let mut binaries = Vec::new();
-    for (platform, library) in libraries {
+    for (folder, extension, library) in libraries {
         let bytes = std::fs::read(library)
             .map_err(|e| format!("cannot read {}: {e}", library.display()))?;
         binaries.push((
-            format!(
-                "binaries/{}/{model_identifier}.{}",
-                platform.folder, platform.extension
-            ),
+            format!("binaries/{folder}/{model_identifier}.{extension}"),
             bytes,
         ));
     }
@@ -663,6 +699,20 @@ mod tests {
         assert!(platforms("").is_err());
     }
 
+    #[cfg(all(target_os = "linux", target_arch = "x86_64"))]
+    #[test]
+    fn fmi3_folders_are_arch_dash_os() {
+        let host = host_platform().unwrap();
+        assert_eq!(
+            (host.folder_for(2), host.folder_for(3)),
+            ("linux64", "x86_64-linux")
+        );
+        assert_eq!(
+            (WIN64.folder_for(2), WIN64.folder_for(3)),
+            ("win64", "x86_64-windows")
+        );
+    }
+
     #[cfg(target_os = "linux")]
     #[test]
     fn fmu_has_the_fmi_layout() {
@@ -678,7 +728,7 @@ mod tests {
             &out,
             xml,
             "flexbody",
-            &[(host_platform().unwrap(), library), (WIN64, dll)],
+            &[("linux64", "so", library), ("win64", "dll", dll)],
             b"{\"name\":\"cantilever\"}",
             &[("resources/meshes/part.msh".into(), b"$MeshFormat".to_vec())],
         )

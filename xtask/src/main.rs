@@ -1,10 +1,10 @@
 //! The project's tasks, run as `cargo xtask <task>` (alias in `.cargo/config.toml`):
 //!
-//! * `fmu [--body FILE] [--out FILE] [--platforms LIST]`: builds the release library (for each
-//!   platform: this machine's and, by default, win64 cross-built with MinGW-w64) and the
-//!   description binary and packages `modelDescription.xml`,
+//! * `fmu [--body FILE] [--out FILE] [--platforms LIST] [--fmi 2|3]`: builds the release library
+//!   (for each platform: this machine's and, by default, win64 cross-built with MinGW-w64) and
+//!   the description binary and packages `modelDescription.xml`,
 //!   `binaries/<platform>/<modelIdentifier>.<ext>` and `resources/body.json` into an FMI 2.0
-//!   `.fmu` (default: `<target>/fmu/<body name>.fmu`).
+//!   (default) or 3.0 `.fmu` (default: `<target>/fmu/<body name>.fmu`, `<body name>-fmi3.fmu`).
 //! * `test [--python-only] [PYTEST ARGS...]`: all Rust tests (`cargo test --workspace`), the
 //!   library's Rust tests cross-built for win64 and run under wine, then the default FMU
 //!   (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
@@ -35,10 +35,11 @@ const USAGE: &str = "\
 usage: cargo xtask <task>
 
 tasks:
-  fmu [--body FILE] [--out FILE] [--platforms LIST]
+  fmu [--body FILE] [--out FILE] [--platforms LIST] [--fmi 2|3]
                                     build the .fmu (default body: examples/cantilever.json,
-                                    default out: <target>/fmu/<body name>.fmu, default
-                                    platforms: linux64,win64; win64 is cross-built with the
+                                    default out: <target>/fmu/<body name>.fmu, or
+                                    <body name>-fmi3.fmu with --fmi 3; default FMI version 2.0,
+                                    default platforms: linux64,win64; win64 is cross-built with the
                                     x86_64-pc-windows-gnu target, which rustup adds, and
                                     Debian's gcc-mingw-w64-x86-64, installed when run as root)
   test [--python-only] [ARGS...]    cargo test --workspace, build the default and the driven
@@ -90,16 +91,25 @@ fn main() -> ExitCode {
 /// The platforms of the `.fmu` unless `--platforms` says otherwise.
 const DEFAULT_PLATFORMS: &str = "linux64,win64";
 
-/// `cargo xtask fmu [--body FILE] [--out FILE] [--platforms LIST]`.
+/// `cargo xtask fmu [--body FILE] [--out FILE] [--platforms LIST] [--fmi 2|3]`.
 fn fmu_task(args: &[String]) -> Result<()> {
     let mut body = None;
     let mut out = None;
     let mut platforms = fmu::platforms(DEFAULT_PLATFORMS)?;
+    let mut fmi = 2;
     let mut args = args.iter();
     while let Some(arg) = args.next() {
         let slot = match arg.as_str() {
             "--body" => &mut body,
             "--out" => &mut out,
+            "--fmi" => {
+                fmi = match args.next().map(String::as_str) {
+                    Some("2") => 2,
+                    Some("3") => 3,
+                    _ => return Err("--fmi needs 2 or 3".into()),
+                };
+                continue;
+            }
             "--platforms" => {
                 let list = args
                     .next()
@@ -116,7 +126,7 @@ fn fmu_task(args: &[String]) -> Result<()> {
         *slot = Some(std::path::absolute(value).map_err(|e| format!("{value}: {e}"))?);
     }
     let workspace = Workspace::locate()?;
-    workspace.build_fmu(body.as_deref(), out.as_deref(), &platforms)?;
+    workspace.build_fmu(body.as_deref(), out.as_deref(), &platforms, fmi)?;
     Ok(())
 }
 
@@ -134,18 +144,19 @@ fn test_task(args: &[String]) -> Result<()> {
         run(workspace.cargo().args(["test", "--workspace"]))?;
         windows_tests(&workspace)?;
     }
-    let fmu = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?)?;
+    let fmu = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?, 2)?;
+    let fmu3 = workspace.build_fmu(None, None, &fmu::platforms(DEFAULT_PLATFORMS)?, 3)?;
     let dll = fmu::build_cross_library(&workspace, fmu::WIN64)?;
     let imports = fmu::check_windows_imports(&dll)?;
     let exports = fmu::check_windows_exports(&dll, &fmu::build_release(&workspace)?.library)?;
     println!(
-        "xtask test: the win64 DLL exports the {exports} fmi2 functions of the linux64 library, unmangled, and imports only Windows' own DLLs: {}",
+        "xtask test: the win64 DLL exports the {exports} fmi2 and fmi3 functions of the linux64 library, unmangled, and imports only Windows' own DLLs: {}",
         imports.join(", ")
     );
     // The other release builds are no-ops: only the packaging differs.
     let host = [fmu::host_platform()?];
-    let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None, &host)?;
-    let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None, &host)?;
+    let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None, &host, 2)?;
+    let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None, &host, 2)?;
     let python = venv::ensure(&workspace)?;
     println!(
         "xtask test: Python tests (pytest tests/python) on {} and {}",
@@ -158,6 +169,7 @@ fn test_task(args: &[String]) -> Result<()> {
         .args(["-m", "pytest", "tests/python"])
         .args(pytest_args)
         .env("FLEXBODY_FMU", &fmu)
+        .env("FLEXBODY_FMU3", &fmu3)
         .env("FLEXBODY_DRIVEN_FMU", &driven_fmu)
         .env("FLEXBODY_CONROD_FMU", &conrod_fmu)
         .env("MPLBACKEND", "Agg");
@@ -222,7 +234,7 @@ fn demo_task(args: &[String]) -> Result<()> {
     }
     let workspace = Workspace::locate()?;
     // The demo runs here: this machine's binary is all it needs.
-    let fmu = workspace.build_fmu(None, None, &[fmu::host_platform()?])?;
+    let fmu = workspace.build_fmu(None, None, &[fmu::host_platform()?], 2)?;
     let python = venv::ensure(&workspace)?;
     let plot = workspace.target_dir.join("demo").join("cantilever.png");
     let mut demo = Command::new(&python);
@@ -311,12 +323,14 @@ impl Workspace {
         self.root.join("examples").join("conrod.json")
     }
 
-    /// Builds and packages the FMU with the binaries of `platforms`; returns its path.
+    /// Builds and packages the FMI `fmi` (2 or 3) FMU with the binaries of `platforms`;
+    /// returns its path.
     fn build_fmu(
         &self,
         body: Option<&Path>,
         out: Option<&Path>,
         platforms: &[fmu::Platform],
+        fmi: u8,
     ) -> Result<PathBuf> {
         let body = body.map_or_else(|| self.default_body(), Path::to_path_buf);
         let artifacts = fmu::build_release(self)?;
@@ -324,7 +338,7 @@ impl Workspace {
         for &platform in platforms.iter().filter(|p| p.rust_target.is_some()) {
             others.push((platform, fmu::build_cross_library(self, platform)?));
         }
-        let package = fmu::package(self, &artifacts, &others, &body, out)?;
+        let package = fmu::package(self, &artifacts, &others, &body, out, fmi)?;
         let size = std::fs::metadata(&package)
             .map_err(|e| format!("{}: {e}", package.display()))?
             .len();
