@@ -157,6 +157,10 @@ fn test_task(args: &[String]) -> Result<()> {
     let host = [fmu::host_platform()?];
     let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None, &host, 2)?;
     let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None, &host, 2)?;
+    // The win64 DLL is also run under wine by fmpy's remoting server (tests/python/test_win64.py),
+    // with the stand-in for wine 8.0's missing bcryptprimitives.dll beside the server.
+    let wine64 = fmu::ensure_wine64()?;
+    let stand_in = fmu::build_wine_stand_in(&workspace, &workspace.target_dir.join("wine"))?;
     let python = venv::ensure(&workspace)?;
     println!(
         "xtask test: Python tests (pytest tests/python) on {} and {}",
@@ -170,6 +174,8 @@ fn test_task(args: &[String]) -> Result<()> {
         .args(pytest_args)
         .env("FLEXBODY_FMU", &fmu)
         .env("FLEXBODY_FMU3", &fmu3)
+        .env("FLEXBODY_WINE64", &wine64)
+        .env("FLEXBODY_WINE_STAND_IN", &stand_in)
         .env("FLEXBODY_DRIVEN_FMU", &driven_fmu)
         .env("FLEXBODY_CONROD_FMU", &conrod_fmu)
         .env("MPLBACKEND", "Agg");
