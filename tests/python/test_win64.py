@@ -6,11 +6,11 @@ tests under wine. Here the packaged DLL itself runs under wine inside fmpy's rem
 (``fmpy/remoting/win64/server_tcp.exe``, which loads it with ``LoadLibrary`` and serves its
 ``fmi2*`` functions over TCP) and is driven from Linux through fmpy's remoting client
 (``client_tcp.so``). The server is started here rather than by the client: the client's own
-start (``fmpy.util.add_remoting``) hands the server a lock file whose permissions come from
-``open()`` without a mode, and the server under wine, which polls that file to notice that the
-client has gone, found it writable and exited right after starting in three runs out of four, the
-client then waiting for good. A client whose model identifier is ``client_tcp`` connects to a
-server already running instead."""
+start (``fmpy.util.add_remoting``) hands the server a lock file, held with a POSIX read lock, that
+the server polls every 0.5 s to notice that the client has gone; under wine, whose ``CreateFile``
+does not see POSIX locks, the server opened it, printed "Lock file ... open. Exiting." and stopped
+in three runs out of four, the client then waiting for good. A client whose model identifier is
+``client_tcp`` connects to a server already running instead."""
 
 import os
 import pathlib
