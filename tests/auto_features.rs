@@ -274,8 +274,9 @@ fn model_auto_is_a_parameter_of_the_body_file_and_the_fmu() {
 fn slabs_that_do_not_converge_are_refused() {
     // B1 under 5 kN (the tip would swing ~0.6 m, far beyond small strain), the defaults: the
     // strain watch's gradient passes the accuracy at once and model.auto switches to slabs, with
-    // which the violent first steps do not converge even at h/8; the step is redone with the
-    // one frame, which converges, and the slabs are not tried again.
+    // which a violent step does not converge even at h/8 (at once, or later as the tip swings
+    // further); the step is redone with the one frame, which converges, and the slabs are not
+    // tried again.
     let mut s = initialized_default(&[("tip.force[2]", -5e3), ("damping.beta", 1e-3)]);
     let mut log = Vec::new();
     for k in 0..50 {
@@ -288,7 +289,7 @@ fn slabs_that_do_not_converge_are_refused() {
         .count();
     let refused = log
         .iter()
-        .filter(|m| m.contains("did not converge with the slabs switched on"))
+        .filter(|m| m.contains("did not converge with the slabs"))
         .count();
     assert_eq!((tried, refused), (1, 1), "{log:?}");
 }

@@ -124,9 +124,10 @@ pub(super) const SWITCH_AT: f64 = 0.25;
 /// by the single frame's artefact, and dropping the slabs applies that difference as a step
 /// load (on B3, slabs from 4 s to 10 s ended 7.1 % off `full` against 0.57 % when kept).
 /// Switching needs no state transfer (the state is nodal positions) and no factorization (the
-/// constant iteration matrix holds the same `K`). If the communication step does not converge
-/// with the slabs just switched on, `Slave::do_step` redoes it with the one frame and the
-/// slabs are not tried again (B1 under 5 kN, far beyond small strain).
+/// constant iteration matrix holds the same `K`). If a communication step does not converge
+/// with the slabs on (just switched on, or later as the body goes on bending violently),
+/// `Slave::do_step` redoes it with the one frame and the slabs are not tried again (B1 under
+/// 5 kN, far beyond small strain).
 fn choose_slabs(model: &Model, dynamics: &mut Dynamics, accuracy: f64, events: &mut Vec<LogEvent>) {
     let f = dynamics.features;
     if !model.allowed.frames || f.frames || f.frames_refused {

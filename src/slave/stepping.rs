@@ -61,10 +61,12 @@ impl Slave {
                 }
             }
             let dynamics = self.dynamics.as_mut().unwrap();
-            let switched = dynamics.features.frames && !slabs_before;
-            if switched && result.as_ref().is_err_and(|e| e.kind == ErrorKind::Discard) {
-                // model.auto's slabs, switched on at this communication point, did not
-                // converge: the step is redone with the one frame, for good.
+            let auto_slabs =
+                dynamics.features.frames && self.model.as_ref().unwrap().allowed.frames;
+            if auto_slabs && result.as_ref().is_err_and(|e| e.kind == ErrorKind::Discard) {
+                // model.auto's slabs did not converge (switched on at this communication point,
+                // or earlier and the body has gone on bending violently): the step is redone
+                // with the one frame, for good.
                 dynamics.state.copy_from(self.backup.as_ref().unwrap());
                 dynamics.features.frames = false;
                 dynamics.features.frames_refused = true;
@@ -73,7 +75,8 @@ impl Slave {
                 self.events.push(LogEvent {
                     category: category::EVENTS,
                     message: format!(
-                        "model.auto: the step from t = {t0} did not converge with the slabs switched on ({}); redone with the one co-moving frame, which the body keeps",
+                        "model.auto: the step from t = {t0} did not converge with the slabs {} ({}); redone with the one co-moving frame, which the body keeps",
+                        if slabs_before { "on" } else { "switched on" },
                         result.unwrap_err().message
                     ),
                 });
