@@ -1,0 +1,135 @@
+"""Our reduced body against Exudyn's floating frame of reference on B1, timed the way that holds
+up on a shared machine: interleaved paired runs (issue 17).
+
+    python bench/paired.py --ours PATH --matrices DIR [--rounds 15] [--series 2] [--h 1e-3]
+
+Each side is a separate process that builds its model (setup, timed on its own) and then runs
+B1 for a short and a long time (2 s and 10 s simulated, fixed step h), each from a fresh model:
+ours is `examples/reduced_run.rs` (PATH: its release binary; the reduced body with 8 modes, which
+with the tip interface's attachment modes makes 14 coordinates), the peers are bench/peers.py's
+reduced models (CB-8: 8 fixed-root eigenmodes; CB-8 + tip: the tip face as a second boundary, 14
+coordinates) in Exudyn's regular module and its fast module (`exudynCPPfast`: no range checks,
+vector extensions), selected per process. The cost of a step is the difference of the two runs'
+stepping times over the difference of their step counts, which cancels what a run costs once
+(first factorization, solver initialization).
+
+A round runs every side once, in an order that rotates from round to round, so that each of our
+runs has its peers' runs within seconds of it; the ratio ours/peer of a round uses those runs
+only, and the figure is the median of the rounds' ratios, with their range. The whole is done
+`--series` times; a ratio is a result only if the series agree (their medians are printed side
+by side).
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+PEERS = [
+    ("Exudyn CB-8", "cb8", False),
+    ("Exudyn CB-8, fast module", "cb8", True),
+    ("Exudyn CB-8 + tip, fast module", "cb8tip", True),
+]
+
+
+def worker(args):
+    """One peer process: setup, then the short and the long run; one JSON line."""
+    if args.fast:
+        sys.exudynFast = True  # read by `import exudyn` (bench/peers.py imports it)
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import peers
+
+    started = time.perf_counter()
+    fem, w, root, tip = peers.load_fem(args.matrices)
+    make, modes = peers.build_reduced(fem, w, root, tip, args.model == "cb8tip")
+    built = make()
+    setup = time.perf_counter() - started
+    times, tip_y = [], None
+    for end, model in ((args.short, built), (args.long, None)):
+        sc, mbs, sensor = model if model is not None else make()
+        s = peers.settings(args.h, end, False)
+        started = time.perf_counter()
+        mbs.SolveDynamic(s)
+        times.append(time.perf_counter() - started)
+        if tip_y is None:
+            tip_y = float(mbs.GetSensorStoredData(sensor)[-1, 2])
+    module = "exudynCPPfast" if "exudyn.exudynCPPfast" in sys.modules else "exudynCPP"
+    print(json.dumps({
+        "setup_s": setup, "short_s": times[0], "short_steps": round(args.short / args.h),
+        "long_s": times[1], "long_steps": round(args.long / args.h), "tip_y_short": tip_y,
+        "modes": modes, "module": module,
+    }))
+
+
+def run(command):
+    out = subprocess.run(command, check=True, capture_output=True, text=True,
+                         env={**os.environ, "PYTHONWARNINGS": "ignore"}).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def per_step(r):
+    return (r["long_s"] - r["short_s"]) / (r["long_steps"] - r["short_steps"])
+
+
+def series(args, sides):
+    """`args.rounds` rounds over `sides` (name, command); per round each side's result."""
+    rounds = []
+    for k in range(args.rounds):
+        order = sides[k % len(sides):] + sides[:k % len(sides)]
+        rounds.append({name: run(command) for name, command in order})
+    return rounds
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--ours")
+    parser.add_argument("--matrices", required=True)
+    parser.add_argument("--rounds", type=int, default=15)
+    parser.add_argument("--series", type=int, default=2)
+    parser.add_argument("--h", type=float, default=1e-3)
+    parser.add_argument("--short", type=float, default=2.0)
+    parser.add_argument("--long", type=float, default=10.0)
+    parser.add_argument("--worker", action="store_true")
+    parser.add_argument("--model", default="cb8")
+    parser.add_argument("--fast", action="store_true")
+    args = parser.parse_args()
+    if args.worker:
+        return worker(args)
+
+    timing = ["--h", str(args.h), "--short", str(args.short), "--long", str(args.long)]
+    sides = [("ours", [args.ours, *timing])]
+    for name, model, fast in PEERS:
+        command = [sys.executable, os.path.abspath(__file__), "--worker", "--matrices", args.matrices,
+                   "--model", model, *timing] + (["--fast"] if fast else [])
+        sides.append((name, command))
+
+    print(f"B1, h = {args.h:g} s, per-step cost from {args.short:g} s and {args.long:g} s simulated; "
+          f"{args.series} series of {args.rounds} interleaved rounds (sides in rotating order)\n")
+    results = [series(args, sides) for _ in range(args.series)]
+
+    print("| side | module | setup (s, median) | µs per step (median) | tip y at "
+          f"{args.short:g} s (m) |")
+    print("|---|---|---|---|---|")
+    for name, _ in sides:
+        runs = [r[name] for rounds in results for r in rounds]
+        print(f"| {name} | {runs[0].get('module', 'flexbody')} "
+              f"| {statistics.median(r['setup_s'] for r in runs):.3f} "
+              f"| {1e6 * statistics.median(per_step(r) for r in runs):.1f} "
+              f"| {runs[0]['tip_y_short']:.6e} |")
+    print()
+    header = " | ".join(f"series {k + 1}: median (range)" for k in range(args.series))
+    print(f"| ours / peer, per step | {header} |")
+    print("|---|" + "---|" * args.series)
+    for name, _ in sides[1:]:
+        cells = []
+        for rounds in results:
+            ratios = [per_step(r["ours"]) / per_step(r[name]) for r in rounds]
+            cells.append(f"{statistics.median(ratios):.2f} ({min(ratios):.2f}–{max(ratios):.2f})")
+        print(f"| {name} | " + " | ".join(cells) + " |")
+
+
+if __name__ == "__main__":
+    main()
