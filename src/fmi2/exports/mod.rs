@@ -215,36 +215,46 @@ fn instantiate(
             return null_mut();
         }
     };
-    let resource_dir: Option<PathBuf> = match resource_location.as_deref() {
-        None => {
-            logger.event(&format!(
-                "{F}: no fmuResourceLocation; using the embedded default body"
-            ));
-            None
-        }
-        Some(uri) => match resource_path(uri) {
-            Ok(p) if p.is_dir() => {
-                logger.event(&format!("{F}: resources in {}", p.display()));
-                Some(p)
-            }
-            Ok(p) => {
-                logger.event(&format!(
-                    "{F}: resource directory {} does not exist; using the embedded default body",
-                    p.display()
-                ));
-                None
-            }
-            Err(e) => {
-                logger.event(&format!("{F}: {e}; using the embedded default body"));
-                None
-            }
-        },
-    };
+    let resources = resource_location.as_deref().map(resource_path);
+    let resource_dir = resource_directory(F, "fmuResourceLocation", resources, &mut logger);
     let Some(slave) = load_slave(F, &name, &guid, resource_dir.as_deref(), &mut logger) else {
         return null_mut();
     };
     logger.event(&format!("{F}: instance {name} created"));
     Box::into_raw(Box::new(Instance::new(slave, logger))) as fmi2Component
+}
+
+/// The resource directory of a new instance (FMI 2.0 and 3.0) from the importer's argument
+/// `argument` (None: not given; `Err`: not a usable location), or None, logged, for the
+/// embedded default body.
+pub(crate) fn resource_directory(
+    function: &str,
+    argument: &str,
+    location: Option<Result<PathBuf, String>>,
+    logger: &mut Logger,
+) -> Option<PathBuf> {
+    let default = "using the embedded default body";
+    match location {
+        None => {
+            logger.event(&format!("{function}: no {argument}; {default}"));
+            None
+        }
+        Some(Ok(p)) if p.is_dir() => {
+            logger.event(&format!("{function}: resources in {}", p.display()));
+            Some(p)
+        }
+        Some(Ok(p)) => {
+            logger.event(&format!(
+                "{function}: resource directory {} does not exist; {default}",
+                p.display()
+            ));
+            None
+        }
+        Some(Err(e)) => {
+            logger.event(&format!("{function}: {e}; {default}"));
+            None
+        }
+    }
 }
 
 /// The slave of a new instance (FMI 2.0 and 3.0): the body from `resource_dir` (the embedded

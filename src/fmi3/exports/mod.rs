@@ -18,7 +18,9 @@
 
 use super::instance::Fmi3Instance;
 use super::types::*;
-use crate::fmi2::exports::{copy_string, load_slave, panic_text, slice_in, slice_out};
+use crate::fmi2::exports::{
+    copy_string, load_slave, panic_text, resource_directory, slice_in, slice_out,
+};
 use crate::fmi2::logger::{Logger, Sink};
 use crate::fmi2::{fmi2Status, Instance};
 use std::ffi::c_char;
@@ -210,25 +212,8 @@ fn instantiate(
             return null_mut();
         }
     };
-    let resource_dir = match resource_path.map(PathBuf::from) {
-        None => {
-            logger.event(&format!(
-                "{F}: no resourcePath; using the embedded default body"
-            ));
-            None
-        }
-        Some(p) if p.is_dir() => {
-            logger.event(&format!("{F}: resources in {}", p.display()));
-            Some(p)
-        }
-        Some(p) => {
-            logger.event(&format!(
-                "{F}: resource directory {} does not exist; using the embedded default body",
-                p.display()
-            ));
-            None
-        }
-    };
+    let resources = resource_path.map(|p| Ok(PathBuf::from(p)));
+    let resource_dir = resource_directory(F, "resourcePath", resources, &mut logger);
     let Some(slave) = load_slave(F, &name, &token, resource_dir.as_deref(), &mut logger) else {
         return null_mut();
     };
