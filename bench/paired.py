@@ -5,8 +5,8 @@ up on a shared machine: interleaved paired runs (issue 17).
 
 Each side is a separate process that builds its model (setup, timed on its own) and then runs
 B1 for a short and a long time (2 s and 10 s simulated, fixed step h), each from a fresh model:
-ours is `examples/reduced_run.rs` (PATH: its release binary; the reduced body with 8 modes, which
-with the tip interface's attachment modes makes 14 coordinates), the peers are bench/peers.py's
+ours is `examples/reduced_run.rs` (PATH: its release binary; the reduced body with 8 modes: 46
+fields with the supports' constraint and the tip's attachment fields, 138 coordinates), the peers are bench/peers.py's
 reduced models (CB-8: 8 fixed-root eigenmodes; CB-8 + tip: the tip face as a second boundary, 14
 coordinates) in Exudyn's regular module and its fast module (`exudynCPPfast`: no range checks,
 vector extensions), selected per process. The cost of a step is the difference of the two runs'
