@@ -10,8 +10,8 @@
 //! under `<InitialUnknowns>` (no dependencies attribute: depends on all inputs).
 
 use super::variables::{
-    Causality, Variability, Variable, VariableTable, VariableType, ENUMERATIONS, LOG_CATEGORIES,
-    UNITS,
+    Causality, EnumerationSpec, Variability, Variable, VariableTable, VariableType, ENUMERATIONS,
+    LOG_CATEGORIES, UNITS,
 };
 use super::MODEL_IDENTIFIER;
 use std::fmt::Write as _;
@@ -129,15 +129,7 @@ pub fn model_description(
                 a(e.name),
                 a(e.description)
             );
-            for (k, (item, description)) in e.items.iter().enumerate() {
-                let _ = writeln!(
-                    x,
-                    "        <Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
-                    a(item),
-                    k + 1,
-                    a(description)
-                );
-            }
+            enumeration_items(&mut x, e, "        ");
             x.push_str("      </Enumeration>\n    </SimpleType>\n");
         }
         x.push_str("  </TypeDefinitions>\n");
@@ -156,21 +148,8 @@ pub fn model_description(
     for (i, v) in table.iter().enumerate() {
         let index = i + 1;
         let _ = writeln!(x, "    <!-- Index {index} -->");
-        let _ = write!(
-            x,
-            "    <ScalarVariable name=\"{}\" valueReference=\"{}\"",
-            a(&v.name),
-            v.value_reference
-        );
-        if !v.description.is_empty() {
-            let _ = write!(x, " description=\"{}\"", a(&v.description));
-        }
-        let _ = write!(
-            x,
-            " causality=\"{}\" variability=\"{}\"",
-            causality_name(v.causality),
-            variability_name(v.variability)
-        );
+        x.push_str("    <ScalarVariable");
+        variable_attributes(&mut x, &v.name, v.value_reference, v);
         let has_start = match v.causality {
             Causality::Parameter => {
                 x.push_str(" initial=\"exact\"");
@@ -186,15 +165,7 @@ pub fn model_description(
         match v.ty {
             VariableType::Real => {
                 x.push_str("Real");
-                if let Some(unit) = v.unit {
-                    let _ = write!(x, " unit=\"{}\"", a(unit));
-                }
-                if let Some(min) = v.min {
-                    let _ = write!(x, " min=\"{}\"", format_real(min));
-                }
-                if let Some(max) = v.max {
-                    let _ = write!(x, " max=\"{}\"", format_real(max));
-                }
+                real_attributes(&mut x, v);
             }
             VariableType::Integer if v.declared_type.is_some() => {
                 let _ = write!(
@@ -205,12 +176,7 @@ pub fn model_description(
             }
             VariableType::Integer => {
                 x.push_str("Integer");
-                if let Some(min) = v.min {
-                    let _ = write!(x, " min=\"{}\"", format_integer_bound(min));
-                }
-                if let Some(max) = v.max {
-                    let _ = write!(x, " max=\"{}\"", format_integer_bound(max));
-                }
+                integer_bounds(&mut x, v);
             }
             VariableType::Boolean => x.push_str("Boolean"),
             VariableType::String => x.push_str("String"),
@@ -235,6 +201,63 @@ pub fn model_description(
     x.push_str("  </ModelStructure>\n");
     x.push_str("</fmiModelDescription>\n");
     x
+}
+
+/// `name`, `valueReference`, `description` (if any), `causality` and `variability` of a
+/// variable element, each with a leading space (FMI 2.0 and 3.0 alike).
+fn variable_attributes(x: &mut String, name: &str, value_reference: u32, v: &Variable) {
+    let a = escape_attribute;
+    let _ = write!(
+        x,
+        " name=\"{}\" valueReference=\"{value_reference}\"",
+        a(name)
+    );
+    if !v.description.is_empty() {
+        let _ = write!(x, " description=\"{}\"", a(&v.description));
+    }
+    let _ = write!(
+        x,
+        " causality=\"{}\" variability=\"{}\"",
+        causality_name(v.causality),
+        variability_name(v.variability)
+    );
+}
+
+/// `unit`, `min` and `max` of a Real (FMI 3.0: Float64) variable, if set.
+fn real_attributes(x: &mut String, v: &Variable) {
+    if let Some(unit) = v.unit {
+        let _ = write!(x, " unit=\"{}\"", escape_attribute(unit));
+    }
+    if let Some(min) = v.min {
+        let _ = write!(x, " min=\"{}\"", format_real(min));
+    }
+    if let Some(max) = v.max {
+        let _ = write!(x, " max=\"{}\"", format_real(max));
+    }
+}
+
+/// `min` and `max` of an Integer (FMI 3.0: Int32 or Enumeration) variable, if set.
+fn integer_bounds(x: &mut String, v: &Variable) {
+    if let Some(min) = v.min {
+        let _ = write!(x, " min=\"{}\"", format_integer_bound(min));
+    }
+    if let Some(max) = v.max {
+        let _ = write!(x, " max=\"{}\"", format_integer_bound(max));
+    }
+}
+
+/// The `<Item>`s of an enumeration type, values 1, 2, ... (FMI 2.0 and 3.0 alike).
+fn enumeration_items(x: &mut String, e: &EnumerationSpec, indent: &str) {
+    let a = escape_attribute;
+    for (k, (item, description)) in e.items.iter().enumerate() {
+        let _ = writeln!(
+            x,
+            "{indent}<Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
+            a(item),
+            k + 1,
+            a(description)
+        );
+    }
 }
 
 /// `<UnitDefinitions>`: the units the variables use, in the order of `UNITS`; a used unit missing

@@ -14,8 +14,8 @@
 //! * `<ModelStructure>` lists outputs by value reference (`<Output>`, `<InitialUnknown>`).
 
 use super::{
-    causality_name, escape_attribute, format_integer_bound, format_real, log_categories,
-    unit_definitions, variability_name, ModelInfo,
+    enumeration_items, escape_attribute, format_real, integer_bounds, log_categories,
+    real_attributes, unit_definitions, variable_attributes, ModelInfo,
 };
 use crate::model::arrays::array_variables;
 use crate::model::variables::{Causality, Variable, VariableTable, VariableType, ENUMERATIONS};
@@ -62,15 +62,7 @@ pub fn model_description_fmi3(
                 a(e.name),
                 a(e.description)
             );
-            for (k, (item, description)) in e.items.iter().enumerate() {
-                let _ = writeln!(
-                    x,
-                    "      <Item name=\"{}\" value=\"{}\" description=\"{}\"/>",
-                    a(item),
-                    k + 1,
-                    a(description)
-                );
-            }
+            enumeration_items(&mut x, e, "      ");
             x.push_str("    </EnumerationType>\n");
         }
         x.push_str("  </TypeDefinitions>\n");
@@ -99,43 +91,15 @@ pub fn model_description_fmi3(
             VariableType::Boolean => "Boolean",
             VariableType::String => "String",
         };
-        let _ = write!(
-            x,
-            "    <{element} name=\"{}\" valueReference=\"{}\"",
-            a(&array.name),
-            array.value_reference
-        );
-        if !v.description.is_empty() {
-            let _ = write!(x, " description=\"{}\"", a(&v.description));
-        }
-        let _ = write!(
-            x,
-            " causality=\"{}\" variability=\"{}\"",
-            causality_name(v.causality),
-            variability_name(v.variability)
-        );
+        let _ = write!(x, "    <{element}");
+        variable_attributes(&mut x, &array.name, array.value_reference, v);
         match v.ty {
-            VariableType::Real => {
-                if let Some(unit) = v.unit {
-                    let _ = write!(x, " unit=\"{}\"", a(unit));
-                }
-                if let Some(min) = v.min {
-                    let _ = write!(x, " min=\"{}\"", format_real(min));
-                }
-                if let Some(max) = v.max {
-                    let _ = write!(x, " max=\"{}\"", format_real(max));
-                }
-            }
+            VariableType::Real => real_attributes(&mut x, v),
             VariableType::Integer => {
                 if let Some(declared) = v.declared_type {
                     let _ = write!(x, " declaredType=\"{}\"", a(declared));
                 }
-                if let Some(min) = v.min {
-                    let _ = write!(x, " min=\"{}\"", format_integer_bound(min));
-                }
-                if let Some(max) = v.max {
-                    let _ = write!(x, " max=\"{}\"", format_integer_bound(max));
-                }
+                integer_bounds(&mut x, v);
             }
             VariableType::Boolean | VariableType::String => {}
         }
