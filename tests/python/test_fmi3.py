@@ -5,6 +5,7 @@ numbers must agree bit for bit, since the two C layers call the same code with t
 import zipfile
 
 import numpy as np
+import pytest
 from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
@@ -73,5 +74,42 @@ def test_fmi3_state_round_trip_repeats_the_steps(fmu3_path, tmp_path):
         fmu.doStep(t + _ * STEP, STEP)
     assert fmu.getFloat64([vr["tip.position"], vr["time"]], nValues=4) == first
     assert first[2] < 0.0
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_fmi3_bad_input_is_refused_with_a_message_and_changes_nothing(fmu3_path, tmp_path):
+    from fmpy.fmi1 import FMICallException
+
+    md = read_model_description(fmu3_path)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    unzipdir = extract(fmu3_path, unzipdir=str(tmp_path / "fmu3"))
+    messages = []
+
+    def log(environment, status, category, message):
+        messages.append((status, category.decode(), message.decode()))
+
+    fmu = FMU3Slave(
+        guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bad"
+    )
+    fmu.instantiate(logMessage=log)
+    fmu.enterInitializationMode(startTime=0.0)
+    fmu.exitInitializationMode()
+    # A NaN element: refused with the element's name, nothing set (all or nothing).
+    with pytest.raises(FMICallException):
+        fmu.setFloat64([vr["tip.force"]], [1.0, 2.0, float("nan")])
+    assert "tip.force[3]" in messages[-1][2] and messages[-1][1] == "logStatusError"
+    assert fmu.getFloat64([vr["tip.force"]], nValues=3) == [0.0, 0.0, 0.0]
+    # The wrong number of values for an array, and an output set: refused, named.
+    with pytest.raises(FMICallException):
+        fmu.getFloat64([vr["tip.position"]], nValues=2)
+    assert "nValues = 2" in messages[-1][2] and messages[-1][2].startswith("fmi3GetFloat64")
+    with pytest.raises(FMICallException):
+        fmu.setFloat64([vr["tip.position"]], [0.0, 0.0, 0.0])
+    assert "output" in messages[-1][2]
+    # The instance is still usable: the rejected calls changed nothing.
+    fmu.doStep(0.0, STEP)
+    assert fmu.getFloat64([vr["time"]]) == [STEP]
+    assert all(status <= 1 for status, _, text in messages if "fmi3DoStep" in text)
     fmu.terminate()
     fmu.freeInstance()
