@@ -395,3 +395,37 @@ fn what_this_fmu_does_not_offer_is_refused_with_a_message() {
     // A NULL instance is an error, not a crash.
     assert_eq!(unsafe { fmi3Terminate(null_mut()) }, ERR);
 }
+
+#[test]
+fn a_discarded_step_is_rolled_back_and_a_shorter_one_may_follow() {
+    // 100 MN at the tip with the plain iteration: the step of 1 ms does not converge (as in
+    // tests/python/test_capabilities.py); FMI 3.0 keeps the instance in Step Mode.
+    let recorder = Recorder::default();
+    let c = instantiate(&recorder, false);
+    unsafe {
+        assert_eq!(
+            fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3False, 0.0),
+            OK
+        );
+    }
+    let depth = [38u32];
+    let zero = [0i32];
+    assert_eq!(
+        unsafe { fmi3SetInt32(c, depth.as_ptr(), 1, zero.as_ptr(), 1) },
+        OK
+    );
+    assert_eq!(set(c, &[TIP_FORCE], &[0.0, -1e8, 0.0]), OK);
+    assert_eq!(unsafe { fmi3ExitInitializationMode(c) }, OK);
+    let before = get(c, &[TIP_POSITION, 0], 4).1;
+    let (mut e, mut t, mut r, mut l) = (1u8, 1u8, 1u8, f64::NAN);
+    let s = unsafe { fmi3DoStep(c, 0.0, 1e-3, fmi3False, &mut e, &mut t, &mut r, &mut l) };
+    assert_eq!(s, fmi3Status::fmi3Discard);
+    assert_eq!((t, l), (fmi3False, 0.0));
+    assert_eq!(get(c, &[TIP_POSITION, 0], 4).1, before, "rolled back");
+    // Still in Step Mode: inputs may be set and a shorter step taken.
+    assert_eq!(set(c, &[TIP_FORCE], &[0.0, -1e8, 0.0]), OK);
+    let s = unsafe { fmi3DoStep(c, 0.0, 1e-4, fmi3False, &mut e, &mut t, &mut r, &mut l) };
+    assert_eq!(s, OK, "{}", recorder.last());
+    assert_eq!(l, 1e-4);
+    unsafe { fmi3FreeInstance(c) };
+}

@@ -355,6 +355,16 @@ impl<S: CoSimSlave> Instance<S> {
         }
     }
 
+    /// FMI 3.0 after a discarded step: the instance stays in Step Mode (FMI 3.0 has no Step
+    /// Discarded state: `fmi3Discard` leaves the FMU as before the call, and the importer may
+    /// retry with other arguments), with no request to terminate. The slave has rolled back.
+    pub fn continue_after_discard(&mut self) {
+        if self.state == M::StepFailed {
+            self.state = M::StepComplete;
+            self.terminate_requested = false;
+        }
+    }
+
     /// Functions this FMU does not support (`fmi2GetDirectionalDerivative`): `fmi2Error` with a
     /// message.
     pub fn unsupported(&mut self, function: &str, why: &str) -> fmi2Status {

@@ -371,11 +371,15 @@ impl Fmi3Instance {
         }
     }
 
-    /// `fmi3DoStep`: the status and whether the importer should end the simulation (after a
-    /// discarded step, as FMI 2.0's `fmi2Terminated` status).
+    /// `fmi3DoStep`: the status and whether the importer should end the simulation (never: a
+    /// discarded step is rolled back and leaves the instance in Step Mode, ready for a retry
+    /// with a shorter step, FMI 3.0 section 2.2.3).
     pub fn do_step(&mut self, t: f64, h: f64) -> (fmi2Status, bool) {
         let status = self.inner.do_step(t, h);
-        (status, status == fmi2Status::fmi2Discard)
+        if status == fmi2Status::fmi2Discard {
+            self.inner.continue_after_discard();
+        }
+        (status, false)
     }
 
     /// The time of the last successful step.

@@ -3,10 +3,10 @@
 
 use super::*;
 
-/// `fmi3DoStep`: one communication step (synchronous, never early). `eventHandlingNeeded` and
-/// `earlyReturn` are false; `terminateSimulation` is true after a discarded step (the slave
-/// rolled back; the importer may restore a state or end); `lastSuccessfulTime` is the slave's
-/// time. The output pointers may be NULL.
+/// `fmi3DoStep`: one communication step (synchronous, never early). `eventHandlingNeeded`,
+/// `earlyReturn` and `terminateSimulation` are false; after `fmi3Discard` the slave has rolled
+/// back to the step's start and the instance stays in Step Mode, so the importer may retry with
+/// a shorter step; `lastSuccessfulTime` is the slave's time. The output pointers may be NULL.
 #[no_mangle]
 pub unsafe extern "C" fn fmi3DoStep(
     instance: fmi3Instance,
