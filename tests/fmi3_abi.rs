@@ -421,11 +421,45 @@ fn a_discarded_step_is_rolled_back_and_a_shorter_one_may_follow() {
     let s = unsafe { fmi3DoStep(c, 0.0, 1e-3, fmi3False, &mut e, &mut t, &mut r, &mut l) };
     assert_eq!(s, fmi3Status::fmi3Discard);
     assert_eq!((t, l), (fmi3False, 0.0));
+    // loggingOn = false: FMI 3.0 allows messages for fmi3Error and fmi3Fatal only.
+    assert!(
+        recorder.messages.lock().unwrap().is_empty(),
+        "{:?}",
+        recorder.messages.lock().unwrap()
+    );
     assert_eq!(get(c, &[TIP_POSITION, 0], 4).1, before, "rolled back");
     // Still in Step Mode: inputs may be set and a shorter step taken.
     assert_eq!(set(c, &[TIP_FORCE], &[0.0, -1e8, 0.0]), OK);
     let s = unsafe { fmi3DoStep(c, 0.0, 1e-4, fmi3False, &mut e, &mut t, &mut r, &mut l) };
     assert_eq!(s, OK, "{}", recorder.last());
     assert_eq!(l, 1e-4);
+    unsafe { fmi3FreeInstance(c) };
+}
+
+#[test]
+fn start_values_can_be_read_in_instantiated_and_outputs_cannot() {
+    // FMI 3.0, "State: Instantiated": fmi3Get* returns the start values (as set by fmi3Set*).
+    let variables = Slave::from_body(BodyFile::default_body()).unwrap();
+    let vr = |name: &str| variables.variables().by_name(name).unwrap().value_reference;
+    let recorder = Recorder::default();
+    let c = instantiate(&recorder, false);
+    let (beta, step) = (vr("damping.beta"), vr("solver.stepSize"));
+    let (s, start) = get(c, &[beta, step, TIP_FORCE], 5);
+    assert_eq!(s, OK, "{}", recorder.last());
+    let body = BodyFile::default_body();
+    assert_eq!(start[1], body.solver.step_size);
+    assert_eq!(&start[2..], &[0.0; 3]);
+    assert_eq!(set(c, &[beta], &[1e-3]), OK);
+    assert_eq!(get(c, &[beta], 1), (OK, vec![1e-3]));
+    // An output has no start value: refused with its name and the reason.
+    let (s, _) = get(c, &[TIP_POSITION], 3);
+    assert_eq!(s, ERR);
+    let message = recorder.last();
+    assert!(
+        message.contains("tip.position") && message.contains("fmi3EnterInitializationMode"),
+        "{message}"
+    );
+    initialize(c);
+    assert_eq!(get(c, &[beta], 1), (OK, vec![1e-3]));
     unsafe { fmi3FreeInstance(c) };
 }

@@ -97,6 +97,9 @@ pub struct Instance<S: CoSimSlave> {
     terminate_requested: bool,
     /// The strings of the last `fmi2GetString` (valid until the next call on this instance).
     strings: Vec<std::ffi::CString>,
+    /// FMI 3.0: the getters answer in Instantiated with the start values (parameters and
+    /// inputs); FMI 2.0 allows them from Initialization Mode on.
+    start_values_readable: bool,
 }
 
 impl<S: CoSimSlave> Instance<S> {
@@ -108,7 +111,15 @@ impl<S: CoSimSlave> Instance<S> {
             state: M::Instantiated,
             terminate_requested: false,
             strings: Vec::new(),
+            start_values_readable: false,
         }
+    }
+
+    /// The instance of an FMI 3.0 importer: its getters also answer in Instantiated, with the
+    /// start values of the parameters and inputs (FMI 3.0, "State: Instantiated").
+    pub fn reading_start_values(mut self) -> Self {
+        self.start_values_readable = true;
+        self
     }
 
     /// Passes the slave's log messages on to the logger (their categories decide whether they

@@ -4,7 +4,8 @@
 //! Messages with the status categories `logStatusWarning`, `logStatusDiscard`, `logStatusError`
 //! and `logStatusFatal` are always passed on (when there is a logger); `logEvents` and `logSolver`
 //! only when debug logging is on for that category (`fmi2Instantiate(loggingOn)`,
-//! `fmi2SetDebugLogging`).
+//! `fmi2SetDebugLogging`). FMI 3.0 allows fewer: with logging off only errors, so there
+//! `logStatusWarning` and `logStatusDiscard` are passed on only when enabled.
 
 use super::types::{fmi2CallbackLogger, fmi2ComponentEnvironment, fmi2Status};
 use crate::model::variables::LOG_CATEGORIES;
@@ -137,14 +138,15 @@ impl Logger {
         Ok(())
     }
 
-    /// Whether a message of `category` would be passed on: status categories always, debug
-    /// categories when enabled.
+    /// Whether a message of `category` would be passed on: errors always; warnings and
+    /// discards always under FMI 2.0, under FMI 3.0 only when their category is enabled (FMI
+    /// 3.0, `loggingOn`: with logging off only `fmi3Error` and `fmi3Fatal` may be logged);
+    /// debug categories when enabled.
     pub fn is_enabled(&self, category: &str) -> bool {
-        if matches!(
-            category,
-            category::WARNING | category::DISCARD | category::ERROR | category::FATAL
-        ) {
-            return true;
+        match category {
+            category::ERROR | category::FATAL => return true,
+            category::WARNING | category::DISCARD if !self.fmi3 => return true,
+            _ => {}
         }
         LOG_CATEGORIES
             .iter()
@@ -252,6 +254,24 @@ mod tests {
         logger.set_debug_logging(false, None).unwrap();
         logger.event("off again");
         assert_eq!(log.borrow().len(), 4);
+    }
+
+    #[test]
+    fn an_fmi3_logger_with_logging_off_passes_errors_only() {
+        let (logger, log) = capture(false);
+        let mut logger = logger.for_fmi3();
+        logger.log(fmi2Status::fmi2Warning, category::WARNING, "hidden");
+        logger.log(fmi2Status::fmi2Discard, category::DISCARD, "hidden");
+        logger.log(fmi2Status::fmi2Fatal, category::FATAL, "fatal");
+        logger.error("error");
+        assert_eq!(log.borrow().len(), 2);
+        logger
+            .set_debug_logging(true, Some(&["logStatusDiscard"]))
+            .unwrap();
+        logger.log(fmi2Status::fmi2Discard, category::DISCARD, "discard");
+        logger.log(fmi2Status::fmi2Warning, category::WARNING, "hidden");
+        assert_eq!(log.borrow().len(), 3);
+        assert_eq!(log.borrow()[2].2, "discard");
     }
 
     #[test]

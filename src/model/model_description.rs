@@ -135,7 +135,7 @@ pub fn model_description(
         x.push_str("  </TypeDefinitions>\n");
     }
 
-    log_categories(&mut x);
+    log_categories(&mut x, false);
 
     let _ = writeln!(
         x,
@@ -304,16 +304,22 @@ fn unit_definitions(x: &mut String, table: &VariableTable) {
 }
 
 /// `<LogCategories>`: the same element in FMI 2.0 and 3.0.
-fn log_categories(x: &mut String) {
+fn log_categories(x: &mut String, fmi3: bool) {
     let a = escape_attribute;
     if !LOG_CATEGORIES.is_empty() {
         x.push_str("  <LogCategories>\n");
         for (name, description) in LOG_CATEGORIES {
+            // The descriptions name FMI 2.0's statuses (fmi2Warning, ...).
+            let description = if fmi3 {
+                description.replace("fmi2", "fmi3")
+            } else {
+                description.to_string()
+            };
             let _ = writeln!(
                 x,
                 "    <Category name=\"{}\" description=\"{}\"/>",
                 a(name),
-                a(description)
+                a(&description)
             );
         }
         x.push_str("  </LogCategories>\n");

@@ -61,7 +61,10 @@ pub struct Snapshot<T> {
 }
 
 impl<T> Snapshot<T> {
-    /// Whether this looks like a snapshot made by this crate.
+    /// Whether this looks like a snapshot made by this crate. A best-effort check: reading a
+    /// snapshot the importer has already freed is outside FMI's contract (an FMU state must
+    /// not be used after `fmi2FreeFMUstate` / `fmi3FreeFMUState`); the tag poisoned on drop
+    /// makes such a use likely, not certain, to be caught.
     pub fn is_valid(&self) -> bool {
         self.magic == SNAPSHOT_MAGIC
     }

@@ -132,6 +132,32 @@ impl<S: CoSimSlave> Instance<S> {
         })
     }
 
+    /// The calling-sequence check of the getters: the states of `GET`; with
+    /// [`Instance::reading_start_values`] (FMI 3.0) also Instantiated for the variables that
+    /// have a start value (parameters and inputs), not for outputs.
+    fn check_get(
+        &mut self,
+        function: &str,
+        ty: VariableType,
+        vrs: &[u32],
+    ) -> std::result::Result<(), fmi2Status> {
+        if !(self.start_values_readable && self.state == MachineState::Instantiated) {
+            return self.check_state(function, GET);
+        }
+        for &vr in vrs {
+            let reason = match self.lookup(ty, vr) {
+                Ok(v) if v.causality == Causality::Output => format!(
+                    "{} (value reference {vr}) is an output: it has no start value and is computed from fmi2EnterInitializationMode on",
+                    v.name
+                ),
+                Ok(_) => continue,
+                Err(e) => e,
+            };
+            return Err(self.fail(function, &reason));
+        }
+        Ok(())
+    }
+
     /// `fmi2Get{Real,Integer,Boolean}`: `values[i]` of `vrs[i]` (same length, checked by the
     /// caller). Non-finite Reals are refused rather than passed on.
     pub fn get_values<T: FromSlave<S> + Copy + std::fmt::Debug>(
@@ -141,7 +167,7 @@ impl<S: CoSimSlave> Instance<S> {
         values: &mut [T],
     ) -> fmi2Status {
         debug_assert_eq!(vrs.len(), values.len());
-        if let Err(s) = self.check_state(function, GET) {
+        if let Err(s) = self.check_get(function, T::TYPE, vrs) {
             return s;
         }
         for (&vr, out) in vrs.iter().zip(values.iter_mut()) {
@@ -204,7 +230,7 @@ impl<S: CoSimSlave> Instance<S> {
         function: &str,
         vrs: &[u32],
     ) -> (fmi2Status, &[std::ffi::CString]) {
-        if let Err(s) = self.check_state(function, GET) {
+        if let Err(s) = self.check_get(function, VariableType::String, vrs) {
             return (s, &[]);
         }
         let mut values = Vec::with_capacity(vrs.len());

@@ -218,7 +218,7 @@ fn instantiate(
         return null_mut();
     };
     logger.event(&format!("{F}: instance {name} created"));
-    let instance = Fmi3Instance::new(Instance::new(slave, logger));
+    let instance = Fmi3Instance::new(Instance::new(slave, logger).reading_start_values());
     Box::into_raw(Box::new(instance)) as fmi3Instance
 }
 

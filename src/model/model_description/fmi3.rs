@@ -67,7 +67,7 @@ pub fn model_description_fmi3(
         }
         x.push_str("  </TypeDefinitions>\n");
     }
-    log_categories(&mut x);
+    log_categories(&mut x, true);
     let _ = writeln!(
         x,
         "  <DefaultExperiment startTime=\"0.0\" stepSize=\"{}\"/>",
