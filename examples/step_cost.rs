@@ -30,7 +30,7 @@ fn bodies(paths: &[String]) -> Vec<BodyFile> {
     // The reduced body (issue 8): B1 on 8 fixed-interface modes and the interfaces' modes.
     let mut reduced = BodyFile::default_body();
     reduced.name = "cantilever_modes8".into();
-    reduced.model.modes = 8;
+    reduced.model.modes = flexbody::model::body_file::ModesSpec::Count(8);
     vec![
         BodyFile::default_body(),
         reduced,

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use flexbody::body::{NodeSet, Reduction};
+use flexbody::body::{ModeCount, NodeSet, Reduction};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;
@@ -85,7 +85,7 @@ impl B1 {
             &self.lumped,
             boundary,
             loaded,
-            modes,
+            ModeCount::Fixed(modes),
         )
         .unwrap();
         (k, ms, reduction)
@@ -235,6 +235,129 @@ fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
     }
 }
 
+/// `model.modes = auto` (`ModeCount::Accuracy`, docs/formulation.md "How many modes"): the
+/// reduced body's static response to B1's uniform inertial load (gravity, a translational
+/// acceleration: the load no interface carries) is within the accuracy asked of the full
+/// mesh's, in the mass norm; one mode fewer would not have been, and a tighter accuracy takes
+/// more modes. The bound is the choice's own criterion (the fixed-interface modes' truncation
+/// error); the reduced body also holds the attachment modes, and its Galerkin solution is the
+/// best in the energy norm, so the measured error lands at or below the predicted one.
+#[test]
+fn auto_mode_count_meets_the_accuracy_on_the_inertial_load() {
+    let b1 = B1::new();
+    let material = IsotropicMaterial::STEEL;
+    let k = stiffness_matrix(&b1.mesh, &material);
+    let ms = scalar_mass_matrix(&b1.mesh, material.density);
+    let m3 = ms.kron_i3();
+    let n3 = b1.reference.len();
+    // Gravity in −y: f = M g.
+    let mut g = vec![0.0; n3];
+    for i in 0..n3 / 3 {
+        g[3 * i + 1] = -9.81;
+    }
+    let mut load = vec![0.0; n3];
+    m3.mul_vec(&g, &mut load);
+    let full = static_displacement(&k, &b1.free_dofs(), &load, vec![0.0; n3]);
+    let mass_norm = |u: &[f64]| {
+        let mut mu = vec![0.0; u.len()];
+        m3.mul_vec(u, &mut mu);
+        flexbody::linalg::dot(u, &mu).sqrt()
+    };
+    let mut counts = Vec::new();
+    for accuracy in [1e-2, 1e-3, 1e-4] {
+        let reduction = Reduction::new(
+            &b1.reference,
+            &ms,
+            &k,
+            &b1.lumped,
+            &[&b1.root],
+            &[&b1.tip],
+            ModeCount::Accuracy(accuracy),
+        )
+        .unwrap();
+        let choice = reduction.mode_choice.unwrap();
+        assert!(choice.met(), "{choice:?}");
+        assert!(choice.error_one_fewer > accuracy, "{choice:?}");
+        // The reduced static solution: K_ff q = Ψᵀ f on the coordinates the root does not hold.
+        let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
+        let coordinates: Vec<usize> = (0..reduction.field_count)
+            .filter(|k| !held.contains(k))
+            .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+            .collect();
+        let s = reduction.field_count;
+        let mut f = vec![0.0; 3 * s];
+        for i in 0..reduction.node_count {
+            for (field, &value) in reduction.fields[i * s..(i + 1) * s].iter().enumerate() {
+                for d in 0..3 {
+                    f[3 * field + d] += value * load[3 * i + d];
+                }
+            }
+        }
+        let n = coordinates.len();
+        let k_r = reduction.stiffness_matrix.to_dense();
+        let k_ff = DMatrix::from_fn(n, n, |a, b| k_r[(coordinates[a], coordinates[b])]);
+        let q_free = k_ff
+            .cholesky()
+            .unwrap()
+            .solve(&DVector::from_fn(n, |a, _| f[coordinates[a]]));
+        let mut q = vec![0.0; 3 * s];
+        for (a, &c) in coordinates.iter().enumerate() {
+            q[c] = q_free[a];
+        }
+        let reduced = reduction.expand(&q);
+        let difference: Vec<f64> = reduced.iter().zip(&full).map(|(a, b)| a - b).collect();
+        let error = mass_norm(&difference) / mass_norm(&full);
+        println!(
+            "accuracy {accuracy:e}: {} modes (predicted {:.2e}, {:.2e} with one fewer), {} fields; static error under gravity {error:.2e}, tip {:.3e} m against {:.3e} m",
+            choice.count,
+            choice.error,
+            choice.error_one_fewer,
+            s,
+            b1.tip_deflection(&reduced),
+            b1.tip_deflection(&full)
+        );
+        assert!(error <= accuracy, "{error:e} > {accuracy:e}");
+        counts.push(choice.count);
+    }
+    assert!(counts.windows(2).all(|w| w[0] < w[1]), "{counts:?}");
+}
+
+/// `"modes": "auto"` in a body file, on a free body (`examples/tumbling.json`, free-free modes
+/// with inertia relief) and on B3's beam driven by its hub (`examples/hub_beam.json`, a motion
+/// interface): the choice is logged, meets the default accuracy, and the body steps.
+#[test]
+fn auto_mode_count_is_chosen_and_logged_for_free_and_driven_bodies() {
+    for name in ["tumbling", "hub_beam"] {
+        let path = format!("{}/examples/{name}.json", env!("CARGO_MANIFEST_DIR"));
+        let mut json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let model = json
+            .as_object_mut()
+            .unwrap()
+            .entry("model")
+            .or_insert(serde_json::json!({}));
+        model["modes"] = serde_json::json!("auto");
+        let body = BodyFile::from_json(&json.to_string()).unwrap();
+        let mut s = initialized(body, &[]);
+        for k in 0..10 {
+            s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+        }
+        let modes = s
+            .variables()
+            .by_name("model.modes")
+            .unwrap()
+            .value_reference;
+        assert_eq!(s.get_integer(modes).unwrap(), -1);
+        let messages: Vec<String> = s.drain_events().map(|e| e.message).collect();
+        let choice = messages
+            .iter()
+            .find(|m| m.contains("model.modes = auto"))
+            .unwrap_or_else(|| panic!("{name}: no choice logged in {messages:?}"));
+        println!("{name}: {choice}");
+        assert!(!choice.contains("warning"), "{name}: {choice}");
+    }
+}
+
 /// Tip deflection history (relative to the start) of the step response of B1 (10 N at t = 0,
 /// undamped, ρ∞ = 1, h = 1e-4 s) over 30 ms (half a period of f1), and the wall time.
 fn step_response(modes: f64) -> (Vec<f64>, f64) {
@@ -364,6 +487,10 @@ fn step_response_converges_to_the_full_mesh_with_the_number_of_modes() {
     let fine = deviation(8.0);
     assert!(fine < 5e-3, "{fine:e}");
     assert!(fine < 0.1 * coarse, "{fine:e} vs {coarse:e}");
+    // model.modes = auto with the default model.accuracy (1e-2) takes 4 modes
+    // (auto_mode_count_meets_the_accuracy_on_the_inertial_load) and stays within that accuracy.
+    let auto = deviation(-1.0);
+    assert!(auto < 1e-2, "{auto:e}");
 }
 
 /// B4 on the reduced body: the root is a motion interface turning about z at π rad/s for three
@@ -542,5 +669,6 @@ fn unsupported_combinations_are_errors_naming_the_parameter() {
     set(&mut s, "model.modes", 1e6);
     let e = s.exit_initialization_mode().unwrap_err();
     assert!(e.message.contains("model.modes"), "{e}");
-    assert!(s.set_by_name("model.modes", -1.0).is_err());
+    assert!(s.set_by_name("model.modes", -2.0).is_err());
+    assert!(s.set_by_name("model.modes", -1.0).is_ok()); // auto
 }

@@ -13,7 +13,7 @@ pub mod strain_monitor;
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
 pub use patches::Patches;
-pub use reduction::Reduction;
+pub use reduction::{ModeChoice, ModeCount, Reduction};
 
 use crate::fem::nonlinear::SvkSolid;
 use crate::linalg::dense::DenseSymmetric;

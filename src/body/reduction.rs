@@ -76,6 +76,54 @@ pub const DEPENDENCE_CUTOFF: f64 = 1e-9;
 /// about this, mode shapes to its square root: ample for a basis).
 pub const MODE_TOLERANCE: f64 = 1e-9;
 
+/// The largest number of fixed-interface modes [`ModeCount::Accuracy`] takes: a body that
+/// needs more for its inertial loads is better moved on its mesh (the choice says so).
+pub const MAX_CHOSEN_MODES: usize = 128;
+
+/// How many fixed-interface modes the basis takes (`model.modes`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ModeCount {
+    /// `n ≥ 1` modes (`model.modes = n`).
+    Fixed(usize),
+    /// The fewest modes whose static response to the body's inertial loads is within this
+    /// relative error of the full mesh's (`model.modes = auto`, [`ModeChoice`]).
+    Accuracy(f64),
+}
+
+/// The mode count [`ModeCount::Accuracy`] chose, and why (docs/formulation.md, "The reduced
+/// body", "How many modes").
+///
+/// The loads a body meets that no interface carries are the inertial loads of its motion:
+/// `f = M a` for the accelerations `a` of a rigid motion, which span the affine fields
+/// `a = e_d` and `a = (X_b − X̄_b)/L e_d` (translation and gravity; angular and centripetal
+/// acceleration, per unit of acceleration at the distance `L`, the body's largest RMS extent
+/// along an axis). With the boundary held, the static response `u = K_ii⁻¹ f` has the modal
+/// expansion `u = Σ_j φ_j c_j`, `c_j = φ_jᵀ M u` (mass-normalised fixed-interface modes), so
+/// the `n` lowest modes leave the error `‖u − Σ_{j≤n} φ_j c_j‖²_M = ‖u‖²_M − Σ_{j≤n} c_j²`,
+/// exactly and with one solve per load. The count is the smallest `n` whose largest error
+/// over the twelve loads is at most `accuracy` times the largest response: below the modes'
+/// frequencies a load is answered quasi-statically, so this is the reduced body's error in the
+/// mass norm, relative to its deformation scale, that `model.accuracy` measures. (Interface loads need no modes: their static responses, the
+/// attachment modes, are in the basis.)
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ModeChoice {
+    /// The accuracy asked for.
+    pub accuracy: f64,
+    /// Modes taken.
+    pub count: usize,
+    /// The relative error of the inertial loads' static response with `count` modes, and with
+    /// one fewer.
+    pub error: f64,
+    pub error_one_fewer: f64,
+}
+
+impl ModeChoice {
+    /// Whether the accuracy was met within [`MAX_CHOSEN_MODES`].
+    pub fn met(&self) -> bool {
+        self.error <= self.accuracy
+    }
+}
+
 /// The reduced body's basis and constant matrices.
 #[derive(Debug, Clone)]
 pub struct Reduction {
@@ -101,12 +149,15 @@ pub struct Reduction {
     pub held: Vec<Vec<HeldCoordinate>>,
     /// `ω²` of the fixed-interface (or free-free elastic) modes in the basis (1/s²).
     pub mode_eigenvalues: Vec<f64>,
+    /// How the mode count was chosen ([`ModeCount::Accuracy`]; `None` for a given count).
+    pub mode_choice: Option<ModeChoice>,
 }
 
 impl Reduction {
     /// The basis of the module documentation for the mesh data (`reference` flat `3N`, `Ms`,
     /// `K`, HRZ `lumped` masses), boundary sets `boundary` (fixed supports and motion
-    /// interfaces), force interfaces `loaded` and `modes` fixed-interface modes (≥ 1).
+    /// interfaces), force interfaces `loaded` and `modes` fixed-interface modes (a count ≥ 1, or
+    /// the fewest that meet an accuracy, [`ModeChoice`]).
     pub fn new(
         reference: &[f64],
         mass: &SymmetricCsr,
@@ -114,14 +165,19 @@ impl Reduction {
         lumped: &[f64],
         boundary: &[&NodeSet],
         loaded: &[&NodeSet],
-        modes: usize,
+        modes: ModeCount,
     ) -> Result<Reduction> {
         let n = lumped.len();
-        let mut solve = InteriorSolve::new(mass, stiffness, n, boundary, modes)?;
+        let fewest = match modes {
+            ModeCount::Fixed(count) => count,
+            ModeCount::Accuracy(_) => 1,
+        };
+        let mut solve = InteriorSolve::new(mass, stiffness, n, boundary, fewest)?;
         let mut vectors: Vec<Vec<f64>> = Vec::new();
         let set_functions =
             constraint_modes(&mut solve, stiffness, reference, boundary, &mut vectors);
-        let mode_eigenvalues = fixed_interface_modes(&solve, modes, &mut vectors)?;
+        let (mode_eigenvalues, mode_choice) =
+            fixed_interface_modes(&mut solve, modes, reference, lumped, &mut vectors)?;
         attachment_modes(&mut solve, reference, lumped, loaded, &mut vectors);
         let candidates = candidate_fields(&vectors, mass, reference, n);
         let coefficients = boundary_coefficients(&candidates, boundary, &set_functions, reference)?;
@@ -144,6 +200,7 @@ impl Reduction {
             frame_weights,
             held,
             mode_eigenvalues,
+            mode_choice,
         })
     }
 
@@ -208,11 +265,7 @@ struct RigidModes {
 impl RigidModes {
     fn new(reference: &[f64], m3: &SymmetricCsr, lumped: &[f64]) -> RigidModes {
         let n = lumped.len();
-        let total: f64 = lumped.iter().sum();
-        let mut c = Vector3::zeros();
-        for (i, &w) in lumped.iter().enumerate() {
-            c += w * node(reference, i) / total;
-        }
+        let c = mass_centroid(reference, lumped);
         let mut modes = Vec::with_capacity(6);
         for j in 0..6 {
             let e = Vector3::ith(j % 3, 1.0);
@@ -257,6 +310,16 @@ impl RigidModes {
             f.iter_mut().zip(mu).for_each(|(v, m)| *v -= y[a] * m);
         }
     }
+}
+
+/// The centre of mass `Σ m_i X_i / Σ m_i` of the lumped masses (m).
+fn mass_centroid(reference: &[f64], lumped: &[f64]) -> Vector3<f64> {
+    let total: f64 = lumped.iter().sum();
+    let mut c = Vector3::zeros();
+    for (i, &w) in lumped.iter().enumerate() {
+        c += w * node(reference, i) / total;
+    }
+    c
 }
 
 fn dense_symmetric(a: &DMatrix<f64>) -> SymmetricCsr {

@@ -106,8 +106,17 @@ pub fn lowest_eigenpairs(
                 &mut mxbar.as_mut_slice()[j * n..(j + 1) * n],
             );
         }
-        let kr = symmetrize(xbar.transpose() * &mx);
-        let mr = symmetrize(xbar.transpose() * &mxbar);
+        let mut kr = symmetrize(xbar.transpose() * &mx);
+        let mut mr = symmetrize(xbar.transpose() * &mxbar);
+        if mr.clone().cholesky().is_none() {
+            // `K⁻¹ M` scales mode j by 1/λ_j: with the shifted rigid modes of a free body
+            // (λ = σ, small) every column is nearly in their span and `M_r` is too ill-conditioned
+            // to factor. Make the columns M-orthonormal (Gram–Schmidt twice), which keeps the
+            // span, and form the Ritz matrices again.
+            m_orthonormalize(m, &mut xbar, &mut mx, &mut mxbar);
+            kr = symmetrize(xbar.transpose() * &mx);
+            mr = symmetrize(xbar.transpose() * &mxbar);
+        }
         let chol = mr.clone().cholesky().ok_or_else(|| {
             Error::new(
                 "modal analysis: the Ritz basis lost independence (M_r not positive definite)",
@@ -145,6 +154,46 @@ pub fn lowest_eigenpairs(
     Err(Error::new(format!(
         "modal analysis: subspace iteration did not converge to {tolerance:e} in {max_iterations} iterations"
     )))
+}
+
+/// Makes the columns of `x` (n × q) M-orthonormal by modified Gram–Schmidt, twice, applying the
+/// same column operations to `k_x = K x` (known only as the products it stands for: the
+/// operations are linear) and recomputing `m_x = M x`.
+fn m_orthonormalize(
+    m: &SymmetricCsr,
+    x: &mut DMatrix<f64>,
+    k_x: &mut DMatrix<f64>,
+    m_x: &mut DMatrix<f64>,
+) {
+    let (n, q) = x.shape();
+    for _ in 0..2 {
+        for j in 0..q {
+            let (xs, ms) = (x.as_mut_slice(), m_x.as_mut_slice());
+            m.mul_vec(&xs[j * n..(j + 1) * n], &mut ms[j * n..(j + 1) * n]);
+            for i in 0..j {
+                let c = crate::linalg::dot(
+                    &x.as_slice()[i * n..(i + 1) * n],
+                    &m_x.as_slice()[j * n..(j + 1) * n],
+                );
+                for r in 0..n {
+                    x[(r, j)] -= c * x[(r, i)];
+                    m_x[(r, j)] -= c * m_x[(r, i)];
+                    k_x[(r, j)] -= c * k_x[(r, i)];
+                }
+            }
+            let norm = crate::linalg::dot(
+                &x.as_slice()[j * n..(j + 1) * n],
+                &m_x.as_slice()[j * n..(j + 1) * n],
+            )
+            .max(f64::MIN_POSITIVE)
+            .sqrt();
+            for r in 0..n {
+                x[(r, j)] /= norm;
+                m_x[(r, j)] /= norm;
+                k_x[(r, j)] /= norm;
+            }
+        }
+    }
 }
 
 /// `(A + Aᵀ) / 2`.

@@ -248,9 +248,10 @@ pub struct ModelSpec {
     pub frames: u32,
     /// Reduced body (`model.modes`, see `body::reduction`): 0 (the default) moves every mesh
     /// node; `n > 0` restricts the deformation to `n` fixed-interface modes plus the interfaces'
-    /// constraint and attachment modes (component mode synthesis in absolute coordinates).
+    /// constraint and attachment modes (component mode synthesis in absolute coordinates);
+    /// `"auto"` takes the modes `model.accuracy` needs.
     #[serde(default)]
-    pub modes: u32,
+    pub modes: ModesSpec,
     /// `model.auto` (default true): the nonlinear force and the stiffening are upper bounds, each
     /// switched on per step only when it changes the result beyond the solver tolerance; `f_nl`
     /// stays off on a supported body with one frame.
@@ -268,7 +269,7 @@ impl Default for ModelSpec {
         ModelSpec {
             nonlinear_forces: false,
             frames: ModelSpec::default_frames(),
-            modes: 0,
+            modes: ModesSpec::default(),
             auto: ModelSpec::default_auto(),
             accuracy: ModelSpec::default_accuracy(),
         }
@@ -284,6 +285,40 @@ impl ModelSpec {
     }
     fn default_accuracy() -> f64 {
         1e-2
+    }
+}
+
+/// `model.modes` as an FMU parameter: the reduced body with the modes its accuracy needs.
+pub const MODES_AUTO: i32 = -1;
+
+/// `model.modes` in a body file: a count (0: the full mesh) or `"auto"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ModesSpec {
+    Count(u32),
+    Named(ModesWord),
+}
+
+/// The word a body file may give `model.modes`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModesWord {
+    Auto,
+}
+
+impl Default for ModesSpec {
+    fn default() -> Self {
+        ModesSpec::Count(0)
+    }
+}
+
+impl ModesSpec {
+    /// The FMU parameter's value: the count, or [`MODES_AUTO`].
+    pub fn parameter(self) -> i32 {
+        match self {
+            ModesSpec::Count(n) => n.min(i32::MAX as u32) as i32,
+            ModesSpec::Named(ModesWord::Auto) => MODES_AUTO,
+        }
     }
 }
 

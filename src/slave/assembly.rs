@@ -6,11 +6,12 @@ use super::{LogEvent, Slave};
 use crate::body::feature_indicators::{self, FeatureIndicators};
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
-use crate::body::{Body, BodyOptions, NodeSet, Patches, Reduction};
+use crate::body::{Body, BodyOptions, ModeCount, NodeSet, Patches, Reduction};
 use crate::error::{Error, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::linalg::SymmetricCsr;
+use crate::model::body_file::MODES_AUTO;
 use crate::model::category;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
@@ -21,6 +22,10 @@ use crate::solver::integrator::{Damping, FactorCache, TimeIntegrator};
 use crate::solver::problem::{FreeNodes, ResidualWorkspace};
 use crate::solver::radau::{RadauIIA, RadauWorkspace};
 use nalgebra::Vector3;
+
+/// The accuracy `model.modes = auto` meets when `model.accuracy` is 0 (the fixed step): the
+/// body file's default `model.accuracy`.
+const DEFAULT_MODES_ACCURACY: f64 = 1e-2;
 
 /// The terms in force during a step: with `model.auto` chosen per communication step by
 /// [`FeatureIndicators`] among the allowed ones, otherwise the forced switches. Part of the
@@ -140,7 +145,7 @@ impl Slave {
             damping_alpha: p.damping_alpha,
             damping_beta: p.damping_beta,
         };
-        let (body, clamped) = if p.modes > 0 {
+        let (body, clamped) = if p.modes != 0 {
             self.reduced_body(&matrices, &lumped, options)?
         } else {
             (
@@ -212,7 +217,7 @@ impl Slave {
         })
     }
 
-    /// The reduced body (`model.modes > 0`, docs/formulation.md, "The reduced body") and which
+    /// The reduced body (`model.modes ≠ 0`, docs/formulation.md, "The reduced body") and which
     /// of its fields are held by supports and motion interfaces; the interfaces' node sets are
     /// expressed in its fields.
     fn reduced_body(
@@ -238,8 +243,34 @@ impl Slave {
             lumped,
             &sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
             &sets(&[InterfaceKind::Force]),
-            p.modes as usize,
+            if p.modes == MODES_AUTO {
+                // docs/formulation.md, "How many modes".
+                let accuracy = if p.accuracy > 0.0 {
+                    p.accuracy
+                } else {
+                    DEFAULT_MODES_ACCURACY
+                };
+                ModeCount::Accuracy(accuracy)
+            } else {
+                ModeCount::Fixed(p.modes as usize)
+            },
         )?;
+        if let Some(choice) = &reduction.mode_choice {
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: if choice.met() {
+                    format!(
+                        "model.modes = auto: {} fixed-interface modes, the fewest whose static response to the body's inertial loads is within {:e} of the full mesh's (mass norm): {:.2e} ({:.2e} with one fewer)",
+                        choice.count, choice.accuracy, choice.error, choice.error_one_fewer
+                    )
+                } else {
+                    format!(
+                        "warning: model.modes = auto: {} fixed-interface modes (the most it takes) leave {:.2e} of the static response to the body's inertial loads, more than the {:e} asked: this body needs its mesh (model.modes = 0) for that accuracy",
+                        choice.count, choice.error, choice.accuracy
+                    )
+                },
+            });
+        }
         let frequencies: Vec<String> = reduction
             .mode_eigenvalues
             .iter()

@@ -37,7 +37,8 @@ pub struct Parameters {
     pub stiffening: Stiffening,
     /// `model.frames`: co-moving frames of the reduced-strain body (≥ 1).
     pub frames: i32,
-    /// `model.modes`: 0 the full mesh, `n > 0` the reduced body with `n` fixed-interface modes.
+    /// `model.modes`: 0 the full mesh, `n > 0` the reduced body with `n` fixed-interface modes,
+    /// `MODES_AUTO` (-1) the reduced body with the modes its accuracy needs.
     pub modes: i32,
     /// `solver.andersonDepth`: history of Anderson's acceleration (0 to 8).
     pub anderson_depth: i32,
@@ -74,7 +75,7 @@ impl Parameters {
             formulation: Formulation::default(),
             stiffening: Stiffening::default(),
             frames: b.model.frames.clamp(1, i32::MAX as u32) as i32,
-            modes: b.model.modes.min(i32::MAX as u32) as i32,
+            modes: b.model.modes.parameter(),
             anderson_depth: b.solver.anderson_depth.min(MAX_DEPTH as u32) as i32,
             integrator: b.solver.integrator,
             output_directory: String::new(),

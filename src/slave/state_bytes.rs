@@ -471,8 +471,8 @@ fn check_parameters(p: &Parameters) -> Result<()> {
     if p.frames < 1 {
         return bad("model.frames", p.frames, "must be at least 1");
     }
-    if p.modes < 0 {
-        return bad("model.modes", p.modes, "must not be negative");
+    if p.modes < crate::model::body_file::MODES_AUTO {
+        return bad("model.modes", p.modes, "must be at least -1 (auto)");
     }
     if !(0..=crate::solver::anderson::MAX_DEPTH as i32).contains(&p.anderson_depth) {
         return bad("solver.andersonDepth", p.anderson_depth, "not in [0, 8]");

@@ -4,7 +4,10 @@
 //! fields, the reduced mass and stiffness, the frame of the expanded nodes, the held
 //! coordinates.
 
-use super::{affine_directions, RigidModes, COMPONENT_CUTOFF, DEPENDENCE_CUTOFF, MODE_TOLERANCE};
+use super::{
+    affine_directions, mass_centroid, ModeChoice, ModeCount, RigidModes, COMPONENT_CUTOFF,
+    DEPENDENCE_CUTOFF, MAX_CHOSEN_MODES, MODE_TOLERANCE,
+};
 use crate::body::frame::{node, FrameWeights};
 use crate::body::interface::{HeldCoordinate, NodeSet};
 use crate::error::{Error, Result};
@@ -151,31 +154,135 @@ pub(super) fn constraint_modes(
     set_functions
 }
 
-/// The `modes` lowest fixed-interface (free-free for an unsupported body) modes, appended to
-/// `vectors`; their eigenvalues `ω²`.
+/// The fixed-interface (free-free for an unsupported body) modes, the `n` lowest for
+/// [`ModeCount::Fixed`] or as many as [`ModeChoice`] finds for [`ModeCount::Accuracy`],
+/// appended to `vectors`; their eigenvalues `ω²` and the choice.
 pub(super) fn fixed_interface_modes(
-    solve: &InteriorSolve,
-    modes: usize,
+    solve: &mut InteriorSolve,
+    modes: ModeCount,
+    reference: &[f64],
+    lumped: &[f64],
     vectors: &mut Vec<Vec<f64>>,
-) -> Result<Vec<f64>> {
+) -> Result<(Vec<f64>, Option<ModeChoice>)> {
     // 3. Fixed-interface (or free-free) modes.
     let rigid = if solve.free_body { 6 } else { 0 };
-    let pairs = lowest_eigenpairs(
-        &solve.k_solve,
-        &solve.m_ii,
-        modes + rigid,
-        MODE_TOLERANCE,
-        500,
-    )
-    .map_err(|e| Error::new(format!("model.modes: {}", e.message)))?;
-    let mode_eigenvalues = pairs.eigenvalues[rigid..]
+    let eigenpairs = |solve: &InteriorSolve, count: usize| {
+        lowest_eigenpairs(
+            &solve.k_solve,
+            &solve.m_ii,
+            count + rigid,
+            MODE_TOLERANCE,
+            500,
+        )
+        .map_err(|e| Error::new(format!("model.modes: {}", e.message)))
+    };
+    let (pairs, count, choice) = match modes {
+        ModeCount::Fixed(count) => (eigenpairs(solve, count)?, count, None),
+        ModeCount::Accuracy(accuracy) => {
+            let loads = inertial_responses(solve, reference, lumped);
+            let available = (solve.interior.len() - rigid).min(MAX_CHOSEN_MODES);
+            let mut batch = 8.min(available);
+            loop {
+                let pairs = eigenpairs(solve, batch)?;
+                let errors = truncation_errors(&loads, &pairs.modes, rigid);
+                let found = errors.iter().position(|&e| e <= accuracy);
+                if found.is_some() || batch == available {
+                    let count = found.map_or(batch, |k| k + 1);
+                    let choice = ModeChoice {
+                        accuracy,
+                        count,
+                        error: errors[count - 1],
+                        error_one_fewer: if count > 1 { errors[count - 2] } else { 1.0 },
+                    };
+                    break (pairs, count, Some(choice));
+                }
+                batch = (2 * batch).min(available);
+            }
+        }
+    };
+    let mode_eigenvalues = pairs.eigenvalues[rigid..rigid + count]
         .iter()
         .map(|l| l - solve.shift)
         .collect();
-    for mode in &pairs.modes {
+    for mode in &pairs.modes[..rigid + count] {
         vectors.push(solve.expand(mode));
     }
-    Ok(mode_eigenvalues)
+    Ok((mode_eigenvalues, choice))
+}
+
+/// The static responses `u = K_ii⁻¹ f` of the interior to the inertial loads `f = M a` of the
+/// affine accelerations `a = e_d` and `(X_b − X̄_b)/L e_d` ([`ModeChoice`]; `L` the largest
+/// mass-weighted RMS extent of the body along an axis; with inertia relief for an unsupported
+/// body), with `M u` (interior vectors).
+fn inertial_responses(
+    solve: &mut InteriorSolve,
+    reference: &[f64],
+    lumped: &[f64],
+) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let n3 = solve.n3;
+    let centre = mass_centroid(reference, lumped);
+    let total: f64 = lumped.iter().sum();
+    let extent = (0..3)
+        .map(|b| {
+            let spread: f64 = lumped
+                .iter()
+                .enumerate()
+                .map(|(i, &m)| m * (reference[3 * i + b] - centre[b]).powi(2))
+                .sum();
+            (spread / total).sqrt()
+        })
+        .fold(0.0_f64, f64::max);
+    let rigid_modes = solve
+        .free_body
+        .then(|| RigidModes::new(reference, &solve.m3, lumped));
+    let mut responses = Vec::with_capacity(12);
+    for field in 0..4 {
+        for d in 0..3 {
+            let mut a = vec![0.0; n3];
+            for i in 0..n3 / 3 {
+                a[3 * i + d] = match field {
+                    0 => 1.0,
+                    b => (reference[3 * i + b - 1] - centre[b - 1]) / extent,
+                };
+            }
+            let mut load = vec![0.0; n3];
+            solve.m3.mul_vec(&a, &mut load);
+            if let Some(r) = &rigid_modes {
+                r.relieve(&mut load);
+            }
+            let mut u: Vec<f64> = solve.interior.iter().map(|&dof| load[dof]).collect();
+            solve.factor.solve_in_place(&mut u, &mut solve.workspace);
+            let mut mu = vec![0.0; u.len()];
+            solve.m_ii.mul_vec(&u, &mut mu);
+            responses.push((u, mu));
+        }
+    }
+    responses
+}
+
+/// `errors[n − 1]`: the largest mass-norm error over the `loads` of their static responses
+/// expanded in the first `n` elastic `modes` (after `rigid` rigid ones), `n = 1..`, relative
+/// to the largest response ([`ModeChoice`]).
+fn truncation_errors(loads: &[(Vec<f64>, Vec<f64>)], modes: &[Vec<f64>], rigid: usize) -> Vec<f64> {
+    let count = modes.len() - rigid;
+    let mut errors = vec![0.0_f64; count];
+    let mut largest = 0.0_f64;
+    for (u, mu) in loads {
+        let c: Vec<f64> = modes.iter().map(|phi| dot(phi, mu)).collect();
+        // The elastic part of the response (an unsupported body's relieved load has a rigid
+        // part of the order of the shift only).
+        let total = dot(u, mu) - c[..rigid].iter().map(|c| c * c).sum::<f64>();
+        largest = largest.max(total);
+        let mut captured = 0.0;
+        for (n, c) in c[rigid..].iter().enumerate() {
+            captured += c * c;
+            errors[n] = errors[n].max((total - captured).max(0.0));
+        }
+    }
+    if largest > 0.0 {
+        errors.iter_mut().for_each(|e| *e = (*e / largest).sqrt());
+    }
+    errors
 }
 
 /// The attachment modes of the force interfaces `loaded` (unit forces and torques distributed
