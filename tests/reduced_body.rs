@@ -120,6 +120,32 @@ fn static_displacement(
     u
 }
 
+/// The reduced body's static displacement of the mesh nodes under the reduced load `f` (flat
+/// `3s`) with the coordinates of boundary set 0 held: `K_ff q_f = f_f` on the others, `q`
+/// expanded to the nodes. Also `K_ff` and `M_ff` and the free coordinates' count.
+fn reduced_static_displacement(
+    reduction: &Reduction,
+    f: &[f64],
+) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>, usize) {
+    let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
+    let coordinates: Vec<usize> = (0..reduction.field_count)
+        .filter(|k| !held.contains(k))
+        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+        .collect();
+    let n = coordinates.len();
+    let k_r = reduction.stiffness_matrix.to_dense();
+    let m_r = reduction.mass_matrix.kron_i3().to_dense();
+    let k_ff = DMatrix::from_fn(n, n, |a, b| k_r[(coordinates[a], coordinates[b])]);
+    let m_ff = DMatrix::from_fn(n, n, |a, b| m_r[(coordinates[a], coordinates[b])]);
+    let f_free = DVector::from_fn(n, |a, _| f[coordinates[a]]);
+    let q_free = k_ff.clone().cholesky().unwrap().solve(&f_free);
+    let mut q = vec![0.0; 3 * reduction.field_count];
+    for (a, &c) in coordinates.iter().enumerate() {
+        q[c] = q_free[a];
+    }
+    (reduction.expand(&q), k_ff, m_ff, n)
+}
+
 /// The generalized eigenvalues `K v = λ M v` of dense symmetric `K`, `M` (M positive definite),
 /// ascending.
 fn generalized_eigenvalues(k: &DMatrix<f64>, m: &DMatrix<f64>) -> Vec<f64> {
@@ -180,16 +206,6 @@ fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
     .unwrap();
 
     // Reduced body: the root's held coordinates are clamped, the rest is free.
-    let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
-    let coordinates: Vec<usize> = (0..reduction.field_count)
-        .filter(|k| !held.contains(k))
-        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
-        .collect();
-    let n = coordinates.len();
-    let k_r = reduction.stiffness_matrix.to_dense();
-    let m_r = reduction.mass_matrix.kron_i3().to_dense();
-    let k_ff = DMatrix::from_fn(n, n, |a, b| k_r[(coordinates[a], coordinates[b])]);
-    let m_ff = DMatrix::from_fn(n, n, |a, b| m_r[(coordinates[a], coordinates[b])]);
     b1.tip.set_reduction(Some((reduction.basis(), Vec::new())));
     let mut f = vec![0.0; 3 * reduction.field_count];
     b1.tip.distribute(
@@ -198,13 +214,8 @@ fn b1_static_deflection_and_bending_frequencies_match_the_full_mesh() {
         &Vector3::zeros(),
         &mut f,
     );
-    let f_free = DVector::from_fn(n, |a, _| f[coordinates[a]]);
-    let q_free = k_ff.clone().cholesky().unwrap().solve(&f_free);
-    let mut q = vec![0.0; 3 * reduction.field_count];
-    for (a, &c) in coordinates.iter().enumerate() {
-        q[c] = q_free[a];
-    }
-    let reduced_deflection = b1.tip_deflection(&reduction.expand(&q));
+    let (u_reduced, k_ff, m_ff, n) = reduced_static_displacement(&reduction, &f);
+    let reduced_deflection = b1.tip_deflection(&u_reduced);
     let reduced_eigenvalues = generalized_eigenvalues(&k_ff, &m_ff);
 
     let static_error = (reduced_deflection / full_deflection - 1.0).abs();
@@ -279,11 +290,6 @@ fn auto_mode_count_meets_the_accuracy_on_the_inertial_load() {
         assert!(choice.met(), "{choice:?}");
         assert!(choice.error_one_fewer > accuracy, "{choice:?}");
         // The reduced static solution: K_ff q = Ψᵀ f on the coordinates the root does not hold.
-        let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
-        let coordinates: Vec<usize> = (0..reduction.field_count)
-            .filter(|k| !held.contains(k))
-            .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
-            .collect();
         let s = reduction.field_count;
         let mut f = vec![0.0; 3 * s];
         for i in 0..reduction.node_count {
@@ -293,18 +299,7 @@ fn auto_mode_count_meets_the_accuracy_on_the_inertial_load() {
                 }
             }
         }
-        let n = coordinates.len();
-        let k_r = reduction.stiffness_matrix.to_dense();
-        let k_ff = DMatrix::from_fn(n, n, |a, b| k_r[(coordinates[a], coordinates[b])]);
-        let q_free = k_ff
-            .cholesky()
-            .unwrap()
-            .solve(&DVector::from_fn(n, |a, _| f[coordinates[a]]));
-        let mut q = vec![0.0; 3 * s];
-        for (a, &c) in coordinates.iter().enumerate() {
-            q[c] = q_free[a];
-        }
-        let reduced = reduction.expand(&q);
+        let reduced = reduced_static_displacement(&reduction, &f).0;
         let difference: Vec<f64> = reduced.iter().zip(&full).map(|(a, b)| a - b).collect();
         let error = mass_norm(&difference) / mass_norm(&full);
         println!(

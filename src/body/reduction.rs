@@ -103,8 +103,8 @@ pub enum ModeCount {
 /// exactly and with one solve per load. The count is the smallest `n` whose largest error
 /// over the twelve loads is at most `accuracy` times the largest response: below the modes'
 /// frequencies a load is answered quasi-statically, so this is the reduced body's error in the
-/// mass norm, relative to its deformation scale, that `model.accuracy` measures. (Interface loads need no modes: their static responses, the
-/// attachment modes, are in the basis.)
+/// mass norm, relative to its deformation scale, that `model.accuracy` measures. (Interface
+/// loads need no modes: their static responses, the attachment modes, are in the basis.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModeChoice {
     /// The accuracy asked for.
@@ -112,7 +112,7 @@ pub struct ModeChoice {
     /// Modes taken.
     pub count: usize,
     /// The relative error of the inertial loads' static response with `count` modes, and with
-    /// one fewer.
+    /// one fewer (1 with none: the largest response is then missed whole).
     pub error: f64,
     pub error_one_fewer: f64,
 }

@@ -107,21 +107,24 @@ pub fn lowest_eigenpairs(
             );
         }
         let mut kr = symmetrize(xbar.transpose() * &mx);
-        let mut mr = symmetrize(xbar.transpose() * &mxbar);
-        if mr.clone().cholesky().is_none() {
-            // `K⁻¹ M` scales mode j by 1/λ_j: with the shifted rigid modes of a free body
-            // (λ = σ, small) every column is nearly in their span and `M_r` is too ill-conditioned
-            // to factor. Make the columns M-orthonormal (Gram–Schmidt twice), which keeps the
-            // span, and form the Ritz matrices again.
-            m_orthonormalize(m, &mut xbar, &mut mx, &mut mxbar);
-            kr = symmetrize(xbar.transpose() * &mx);
-            mr = symmetrize(xbar.transpose() * &mxbar);
-        }
-        let chol = mr.clone().cholesky().ok_or_else(|| {
-            Error::new(
-                "modal analysis: the Ritz basis lost independence (M_r not positive definite)",
-            )
-        })?;
+        let chol = match symmetrize(xbar.transpose() * &mxbar).cholesky() {
+            Some(chol) => chol,
+            None => {
+                // `K⁻¹ M` scales mode j by 1/λ_j: with the shifted rigid modes of a free body
+                // (λ = σ, small) every column is nearly in their span and `M_r` is too
+                // ill-conditioned to factor. Make the columns M-orthonormal (Gram–Schmidt
+                // twice), which keeps the span, and form the Ritz matrices again.
+                m_orthonormalize(m, &mut xbar, &mut mx, &mut mxbar);
+                kr = symmetrize(xbar.transpose() * &mx);
+                symmetrize(xbar.transpose() * &mxbar)
+                    .cholesky()
+                    .ok_or_else(|| {
+                        Error::new(
+                            "modal analysis: the Ritz basis lost independence (M_r not positive definite)",
+                        )
+                    })?
+            }
+        };
         let l_inv = chol
             .l()
             .solve_lower_triangular(&DMatrix::identity(q, q))

@@ -283,7 +283,8 @@ impl ModelSpec {
     fn default_auto() -> bool {
         true
     }
-    fn default_accuracy() -> f64 {
+    /// `model.accuracy`'s default (also what `model.modes = auto` meets when it is 0).
+    pub fn default_accuracy() -> f64 {
         1e-2
     }
 }
@@ -292,17 +293,9 @@ impl ModelSpec {
 pub const MODES_AUTO: i32 = -1;
 
 /// `model.modes` in a body file: a count (0: the full mesh) or `"auto"`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ModesSpec {
     Count(u32),
-    Named(ModesWord),
-}
-
-/// The word a body file may give `model.modes`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum ModesWord {
     Auto,
 }
 
@@ -317,8 +310,51 @@ impl ModesSpec {
     pub fn parameter(self) -> i32 {
         match self {
             ModesSpec::Count(n) => n.min(i32::MAX as u32) as i32,
-            ModesSpec::Named(ModesWord::Auto) => MODES_AUTO,
+            ModesSpec::Auto => MODES_AUTO,
         }
+    }
+}
+
+impl Serialize for ModesSpec {
+    fn serialize<S: serde::Serializer>(
+        &self,
+        serializer: S,
+    ) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            ModesSpec::Count(n) => serializer.serialize_u32(*n),
+            ModesSpec::Auto => serializer.serialize_str("auto"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for ModesSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(
+        deserializer: D,
+    ) -> std::result::Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = ModesSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("model.modes: a mode count (0: the full mesh, n > 0) or \"auto\"")
+            }
+            fn visit_u64<E: serde::de::Error>(self, n: u64) -> std::result::Result<ModesSpec, E> {
+                u32::try_from(n)
+                    .map(ModesSpec::Count)
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Unsigned(n), &self))
+            }
+            fn visit_i64<E: serde::de::Error>(self, n: i64) -> std::result::Result<ModesSpec, E> {
+                u64::try_from(n)
+                    .map_err(|_| E::invalid_value(serde::de::Unexpected::Signed(n), &self))
+                    .and_then(|n| self.visit_u64(n))
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> std::result::Result<ModesSpec, E> {
+                match s {
+                    "auto" => Ok(ModesSpec::Auto),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(s), &self)),
+                }
+            }
+        }
+        deserializer.deserialize_any(Visitor)
     }
 }
 
@@ -445,5 +481,28 @@ impl BodyFile {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn modes_take_a_count_or_auto_and_name_anything_else() {
+        let parse = |text: &str| serde_json::from_str::<ModesSpec>(text);
+        assert_eq!(parse("8").unwrap(), ModesSpec::Count(8));
+        assert_eq!(parse("\"auto\"").unwrap(), ModesSpec::Auto);
+        for bad in ["-3", "\"many\"", "1.5", "4294967296"] {
+            let e = parse(bad).unwrap_err().to_string();
+            assert!(
+                e.contains("model.modes") && e.contains("auto"),
+                "{bad}: {e}"
+            );
+        }
+        for spec in [ModesSpec::Count(3), ModesSpec::Auto] {
+            assert_eq!(parse(&serde_json::to_string(&spec).unwrap()).unwrap(), spec);
+        }
+        assert_eq!(ModesSpec::Auto.parameter(), MODES_AUTO);
     }
 }

@@ -11,7 +11,6 @@ use crate::error::{Error, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
 use crate::linalg::SymmetricCsr;
-use crate::model::body_file::MODES_AUTO;
 use crate::model::category;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
@@ -22,10 +21,6 @@ use crate::solver::integrator::{Damping, FactorCache, TimeIntegrator};
 use crate::solver::problem::{FreeNodes, ResidualWorkspace};
 use crate::solver::radau::{RadauIIA, RadauWorkspace};
 use nalgebra::Vector3;
-
-/// The accuracy `model.modes = auto` meets when `model.accuracy` is 0 (the fixed step): the
-/// body file's default `model.accuracy`.
-const DEFAULT_MODES_ACCURACY: f64 = 1e-2;
 
 /// The terms in force during a step: with `model.auto` chosen per communication step by
 /// [`FeatureIndicators`] among the allowed ones, otherwise the forced switches. Part of the
@@ -145,8 +140,8 @@ impl Slave {
             damping_alpha: p.damping_alpha,
             damping_beta: p.damping_beta,
         };
-        let (body, clamped) = if p.modes != 0 {
-            self.reduced_body(&matrices, &lumped, options)?
+        let (body, clamped) = if let Some(modes) = p.mode_count() {
+            self.reduced_body(&matrices, &lumped, options, modes)?
         } else {
             (
                 self.mesh_body(matrices, &lumped, options)?,
@@ -217,14 +212,15 @@ impl Slave {
         })
     }
 
-    /// The reduced body (`model.modes ≠ 0`, docs/formulation.md, "The reduced body") and which
-    /// of its fields are held by supports and motion interfaces; the interfaces' node sets are
-    /// expressed in its fields.
+    /// The reduced body with `modes` (`model.modes ≠ 0`, docs/formulation.md, "The reduced
+    /// body") and which of its fields are held by supports and motion interfaces; the
+    /// interfaces' node sets are expressed in its fields.
     fn reduced_body(
         &mut self,
         matrices: &MeshMatrices,
         lumped: &[f64],
         options: BodyOptions,
+        modes: ModeCount,
     ) -> Result<(Body, Vec<bool>)> {
         self.check_reducible()?;
         let p = &self.parameters;
@@ -243,17 +239,7 @@ impl Slave {
             lumped,
             &sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
             &sets(&[InterfaceKind::Force]),
-            if p.modes == MODES_AUTO {
-                // docs/formulation.md, "How many modes".
-                let accuracy = if p.accuracy > 0.0 {
-                    p.accuracy
-                } else {
-                    DEFAULT_MODES_ACCURACY
-                };
-                ModeCount::Accuracy(accuracy)
-            } else {
-                ModeCount::Fixed(p.modes as usize)
-            },
+            modes,
         )?;
         if let Some(choice) = &reduction.mode_choice {
             self.events.push(LogEvent {

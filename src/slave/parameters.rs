@@ -1,8 +1,10 @@
 //! The parameters of the body (`Parameters`, set from the body file and by the importer) and
 //! their mapping to the fixed variables of the variable table.
 
+use crate::body::ModeCount;
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
+use crate::model::body_file::{ModelSpec, MODES_AUTO};
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::variables::{range_violation, FixedKey, FIXED_VARIABLES};
 use crate::model::{BodyFile, Target};
@@ -51,6 +53,20 @@ pub struct Parameters {
 }
 
 impl Parameters {
+    /// The reduced body's mode count (`None`: the full mesh). `auto` meets `model.accuracy`,
+    /// or its default when that is 0 (docs/formulation.md, "How many modes").
+    pub(super) fn mode_count(&self) -> Option<ModeCount> {
+        match self.modes {
+            0 => None,
+            MODES_AUTO => Some(ModeCount::Accuracy(if self.accuracy > 0.0 {
+                self.accuracy
+            } else {
+                ModelSpec::default_accuracy()
+            })),
+            n => Some(ModeCount::Fixed(n as usize)),
+        }
+    }
+
     pub(super) fn from_body_file(b: &BodyFile) -> Parameters {
         Parameters {
             material: IsotropicMaterial {
