@@ -120,6 +120,19 @@ fn static_displacement(
     u
 }
 
+/// The coordinates (flat `3s` indices) not held by the first `sets` boundary sets.
+fn free_coordinates(reduction: &Reduction, sets: usize) -> Vec<usize> {
+    let held: Vec<usize> = reduction.held[..sets]
+        .iter()
+        .flatten()
+        .map(|h| h.index)
+        .collect();
+    (0..reduction.field_count)
+        .filter(|k| !held.contains(k))
+        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
+        .collect()
+}
+
 /// The reduced body's static displacement of the mesh nodes under the reduced load `f` (flat
 /// `3s`) with the coordinates of boundary set 0 held: `K_ff q_f = f_f` on the others, `q`
 /// expanded to the nodes. Also `K_ff` and `M_ff` and the free coordinates' count.
@@ -127,11 +140,7 @@ fn reduced_static_displacement(
     reduction: &Reduction,
     f: &[f64],
 ) -> (Vec<f64>, DMatrix<f64>, DMatrix<f64>, usize) {
-    let held: Vec<usize> = reduction.held[0].iter().map(|h| h.index).collect();
-    let coordinates: Vec<usize> = (0..reduction.field_count)
-        .filter(|k| !held.contains(k))
-        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
-        .collect();
+    let coordinates = free_coordinates(reduction, 1);
     let n = coordinates.len();
     let k_r = reduction.stiffness_matrix.to_dense();
     let m_r = reduction.mass_matrix.kron_i3().to_dense();
@@ -417,11 +426,7 @@ fn a_second_boundary_set_moves_the_reduced_body_as_it_moves_the_full_mesh() {
         let dq_h = q - position(&reduction.reference, h.index);
         dq[3 * h.index..3 * h.index + 3].copy_from_slice(dq_h.as_slice());
     }
-    let held: Vec<usize> = reduction.held.iter().flatten().map(|h| h.index).collect();
-    let coordinates: Vec<usize> = (0..reduction.field_count)
-        .filter(|k| !held.contains(k))
-        .flat_map(|k| [3 * k, 3 * k + 1, 3 * k + 2])
-        .collect();
+    let coordinates = free_coordinates(&reduction, reduction.held.len());
     let n = coordinates.len();
     let k_r = reduction.stiffness_matrix.to_dense();
     let k_dq = &k_r * DVector::from_column_slice(&dq);
