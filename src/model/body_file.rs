@@ -176,6 +176,11 @@ pub struct InterfaceSpec {
     /// Axis of a `hinge` (body coordinates); it passes through the node set's centroid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<[f64; 3]>,
+    /// The node set moves as one rigid body (an RBE2 spider: exact, with Lagrange multipliers;
+    /// docs/formulation.md, "Rigid attachments"). A `fixed` support and a `motion` interface
+    /// clamp their set rigidly anyway.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub rigid: bool,
 }
 
 /// Solver defaults (the FMU's `solver.*` parameters start here).

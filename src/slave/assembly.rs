@@ -323,12 +323,22 @@ impl Slave {
             self.interfaces
                 .iter()
                 .zip(&self.body_file.interfaces)
-                .find(|(i, _)| matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge))
+                .find(|(i, spec)| {
+                    matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge)
+                        || (spec.rigid && i.kind == InterfaceKind::Force)
+                })
                 .map(|(i, spec)| {
-                    format!(
-                        "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
-                        spec.name, i.kind
-                    )
+                    if i.kind == InterfaceKind::Force {
+                        format!(
+                            "interface '{}' is a rigid force interface: rigid attachments are not available on a reduced body yet (use the mesh body, model.modes = 0)",
+                            spec.name
+                        )
+                    } else {
+                        format!(
+                            "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
+                            spec.name, i.kind
+                        )
+                    }
                 })
         };
         match reason {
@@ -461,9 +471,30 @@ impl Slave {
     }
 
     /// The free nodes of `body` (all but the `clamped` ones) with the point constraints of the
-    /// pins and hinges; each interface learns where its constraints start.
+    /// pins and hinges and the rigid sets of rigid attachments; each interface learns where its
+    /// point constraints start.
     fn constrained_free_nodes(&mut self, body: &Body, clamped: &[bool]) -> Result<FreeNodes> {
         let mut free = FreeNodes::new(body, clamped);
+        for (interface, spec) in self.interfaces.iter().zip(&self.body_file.interfaces) {
+            if spec.rigid
+                && matches!(
+                    spec.kind,
+                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                )
+            {
+                if self.parameters.formulation == Formulation::Full {
+                    return Err(Error::new(format!(
+                        "interface '{}': rigid attachments are not available with model.formulation = full (its Newton iteration works in the global frame); use reducedStrain",
+                        spec.name
+                    )));
+                }
+                free.add_rigid_set(
+                    &spec.name,
+                    &interface.set.frame_weights.nodes,
+                    &body.reference,
+                )?;
+            }
+        }
         for (k, interface) in self.interfaces.iter_mut().enumerate() {
             interface.first_constraint = free.constraints.len();
             for (nodes, weights) in &interface.point_constraints {

@@ -230,6 +230,25 @@ pub(super) fn extrapolate(input: &mut Inputs, d: &InputDerivatives, tau: f64) {
 }
 
 impl Slave {
+    /// The Lagrange multipliers of the interfaces: 3 per point constraint of a pin or hinge,
+    /// `3n − 6` per rigid set of `n` nodes (`FreeNodes::multiplier_count` of any model built).
+    pub(super) fn multiplier_count(&self) -> usize {
+        self.interfaces
+            .iter()
+            .zip(&self.body_file.interfaces)
+            .map(|(i, spec)| {
+                let rigid =
+                    spec.rigid && !matches!(i.kind, InterfaceKind::Fixed | InterfaceKind::Motion);
+                3 * i.point_constraints.len()
+                    + if rigid {
+                        3 * i.set.frame_weights.nodes.len() - 6
+                    } else {
+                        0
+                    }
+            })
+            .sum()
+    }
+
     /// The inputs' ages at the current time `t_0` (`t_0 − t_s` per interface) and the driving
     /// frames of the motion interfaces there: the frame of the inputs, extrapolated from their
     /// sample time `t_s` to `t_0` (no allocation unless an input is rejected).

@@ -353,11 +353,7 @@ impl Slave {
                 ]) {
                     r.f64s(v, what)?;
                 }
-                let multipliers: usize = 3 * self
-                    .interfaces
-                    .iter()
-                    .map(|i| i.point_constraints.len())
-                    .sum::<usize>();
+                let multipliers = self.multiplier_count();
                 r.count(multipliers, "constraint multipliers")?;
                 let mut lambda = vec![0.0; multipliers];
                 r.f64s(&mut lambda, "the constraint multipliers")?;

@@ -40,9 +40,9 @@ pub struct CentralDifference {
 impl CentralDifference {
     /// For `body` with HRZ-lumped nodal masses `lumped` (kg) and free nodes `free`.
     pub fn new(body: &Body, lumped: &[f64], free: &FreeNodes) -> Result<CentralDifference> {
-        if !free.constraints.is_empty() {
+        if free.is_constrained() {
             return Err(Error::new(
-                "solver.integrator = centralDifference does not support pin or hinge supports (Lagrange-multiplier constraints); use generalizedAlpha",
+                "solver.integrator = centralDifference does not support pin or hinge supports or rigid attachments (Lagrange-multiplier constraints); use generalizedAlpha",
             ));
         }
         let mut inverse_mass = vec![0.0; lumped.len()];

@@ -16,7 +16,7 @@
 //! `Δx = Δx_u − hR Z μ`. After each iteration `C x = d` holds to round-off: the constraints do
 //! not drift (index 3, solved exactly for the multipliers; no stabilisation needed).
 
-use crate::body::frame::node;
+use crate::body::frame::{nearest_rotation, node};
 use crate::error::{Error, Result};
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use nalgebra::{DMatrix, Matrix3, Vector3};
@@ -56,6 +56,155 @@ impl PointConstraint {
     }
 }
 
+/// A rigid node set (an RBE2 spider, docs/formulation.md "Rigid attachments"): the set's
+/// nodes keep their reference shape, `x_i = c + R_s X̂_i`, exactly.
+///
+/// With the set's centroid `c = Σ x_i / n`, its best-fit rotation `R_s` (the nearest rotation
+/// of `Σ (x_i − c) X̂_iᵀ`) and the local deformation `ū_i = R_sᵀ (x_i − c) − X̂_i`, the
+/// constraint is `h(x) = Vᵀ ū = 0`: `V` (`3n × k`, `k = 3n − 6`) an orthonormal basis of the
+/// set's deformations, the complement of its six rigid motions. At `ū = 0` the Jacobian is
+/// `∂h/∂x = Vᵀ hR_sᵀ` (the best fit takes the rigid part out of `δū`): constant in the set's
+/// frame, like the body's stiffness. The constraint force `hR_s V λ` has no resultant and no
+/// moment (`V` is orthogonal to the rigid motions): it holds the shape and nothing else.
+#[derive(Debug, Clone)]
+pub struct RigidConstraint {
+    /// Global node indices.
+    pub nodes: Vec<usize>,
+    /// Rows of the free DOF vector of each node.
+    pub free_rows: Vec<usize>,
+    /// `X̂_i = X_i − X̄` (m), the reference offsets from the set's centroid.
+    pub offsets: Vec<Vector3<f64>>,
+    /// `V`, column-major (`k` columns of `3n`).
+    pub basis: Vec<f64>,
+}
+
+impl RigidConstraint {
+    /// The rigid set of `nodes` with reference positions `reference` (flat, all nodes); `free_rows`
+    /// as in [`PointConstraint`]. Error if the nodes are collinear (the set has no rotation
+    /// about their line to hold).
+    pub fn new(
+        name: &str,
+        nodes: &[usize],
+        free_rows: Vec<usize>,
+        reference: &[f64],
+    ) -> Result<Self> {
+        let n = nodes.len();
+        let centroid = nodes
+            .iter()
+            .map(|&i| node(reference, i))
+            .sum::<Vector3<f64>>()
+            / n as f64;
+        let offsets: Vec<Vector3<f64>> = nodes
+            .iter()
+            .map(|&i| node(reference, i) - centroid)
+            .collect();
+        // The six rigid motions, orthonormalised; V spans the eigenvectors of I − Q Qᵀ with
+        // eigenvalue 1.
+        let rigid = DMatrix::from_fn(3 * n, 6, |row, col| {
+            let (i, e) = (row / 3, row % 3);
+            if col < 3 {
+                f64::from(u8::from(e == col))
+            } else {
+                Vector3::ith(col - 3, 1.0).cross(&offsets[i])[e]
+            }
+        });
+        let svd = rigid.svd(true, false);
+        let largest = svd.singular_values.max();
+        if svd.singular_values.min() <= 1e-9 * largest {
+            return Err(Error::new(format!(
+                "interface '{name}': a rigid set needs at least three nodes that are not on one line"
+            )));
+        }
+        let q = svd.u.expect("u requested");
+        let projection = DMatrix::identity(3 * n, 3 * n) - &q * q.transpose();
+        let eigen = projection.symmetric_eigen();
+        let mut basis = Vec::with_capacity(3 * n * (3 * n - 6));
+        for (j, &value) in eigen.eigenvalues.iter().enumerate() {
+            if value > 0.5 {
+                basis.extend(eigen.eigenvectors.column(j).iter());
+            }
+        }
+        debug_assert_eq!(basis.len(), 3 * n * (3 * n - 6));
+        Ok(RigidConstraint {
+            nodes: nodes.to_vec(),
+            free_rows,
+            offsets,
+            basis,
+        })
+    }
+
+    /// `k = 3n − 6`, the number of multipliers.
+    pub fn rows(&self) -> usize {
+        3 * self.nodes.len() - 6
+    }
+
+    /// Column `j` of `V` (`3n`).
+    pub fn column(&self, j: usize) -> &[f64] {
+        let n3 = 3 * self.nodes.len();
+        &self.basis[j * n3..(j + 1) * n3]
+    }
+
+    /// The set's best-fit rotation `R_s` at positions `x` (flat, all nodes).
+    pub fn rotation(&self, x: &[f64]) -> Matrix3<f64> {
+        let c = self.centroid(x);
+        let a = self
+            .nodes
+            .iter()
+            .zip(&self.offsets)
+            .fold(Matrix3::zeros(), |a, (&i, o)| {
+                a + (node(x, i) - c) * o.transpose()
+            });
+        nearest_rotation(&a)
+    }
+
+    fn centroid(&self, x: &[f64]) -> Vector3<f64> {
+        self.nodes.iter().map(|&i| node(x, i)).sum::<Vector3<f64>>() / self.nodes.len() as f64
+    }
+
+    /// `h(x) = Vᵀ ū` into `h` (`k`); returns `R_s`.
+    pub fn violation(&self, x: &[f64], h: &mut [f64]) -> Matrix3<f64> {
+        let (c, r) = (self.centroid(x), self.rotation(x));
+        let rt = r.transpose();
+        h.fill(0.0);
+        for (k, (&i, o)) in self.nodes.iter().zip(&self.offsets).enumerate() {
+            let u = rt * (node(x, i) - c) - o;
+            for (j, hj) in h.iter_mut().enumerate() {
+                let v = &self.column(j)[3 * k..3 * k + 3];
+                *hj += v[0] * u[0] + v[1] * u[1] + v[2] * u[2];
+            }
+        }
+        r
+    }
+
+    /// `Σ_i v_i · y_{row_i}` for column `j` of `V` on a free-DOF vector `y` (frame coordinates).
+    pub fn free_dot(&self, j: usize, y: &[f64]) -> f64 {
+        let v = self.column(j);
+        self.free_rows
+            .iter()
+            .enumerate()
+            .map(|(k, &row)| {
+                v[3 * k] * y[row] + v[3 * k + 1] * y[row + 1] + v[3 * k + 2] * y[row + 2]
+            })
+            .sum()
+    }
+
+    /// Adds the constraint force `hR_s V λ` (`λ`: this set's `k` multipliers) to `f` (flat `3N`).
+    pub fn add_force(&self, x: &[f64], multipliers: &[f64], f: &mut [f64]) {
+        let r = self.rotation(x);
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let mut local = Vector3::zeros();
+            for (j, &l) in multipliers.iter().enumerate() {
+                let v = &self.column(j)[3 * k..3 * k + 3];
+                local += l * Vector3::new(v[0], v[1], v[2]);
+            }
+            let g = r * local;
+            for d in 0..3 {
+                f[3 * i + d] += g[d];
+            }
+        }
+    }
+}
+
 /// The constraint-dependent part of one iteration matrix: `Z = S̄⁻¹ Cᵀ` (free DOFs × 3m,
 /// column-major) and `Ā⁻¹` (3m × 3m).
 #[derive(Debug, Clone)]
@@ -68,14 +217,17 @@ pub struct ConstraintFactor {
 }
 
 impl ConstraintFactor {
-    /// `Z` and `Ā⁻¹` for the factor of `S̄` (3m solves; at factorization time only).
+    /// `Z` and `Ā⁻¹` for the factor of `S̄` (one solve per multiplier; at factorization time
+    /// only). The point constraints' rows come first (3 each), then the rigid sets' (`k` each).
     pub fn new(
         constraints: &[PointConstraint],
+        rigid: &[RigidConstraint],
         factor: &SparseCholesky,
         workspace: &mut SolveWorkspace,
     ) -> Result<ConstraintFactor> {
         let n = factor.dim();
-        let m = 3 * constraints.len();
+        let points = 3 * constraints.len();
+        let m = points + rigid.iter().map(RigidConstraint::rows).sum::<usize>();
         let mut z = vec![0.0; n * m];
         for (p, c) in constraints.iter().enumerate() {
             for d in 0..3 {
@@ -86,7 +238,20 @@ impl ConstraintFactor {
                 factor.solve_in_place(column, workspace);
             }
         }
-        // Ā = C Z: row (q, e) of C picks Σ ŵ_i over constraint q's nodes at direction e.
+        let mut col = points;
+        for set in rigid {
+            for j in 0..set.rows() {
+                let column = &mut z[col * n..(col + 1) * n];
+                let v = set.column(j);
+                for (k, &row) in set.free_rows.iter().enumerate() {
+                    column[row..row + 3].copy_from_slice(&v[3 * k..3 * k + 3]);
+                }
+                factor.solve_in_place(column, workspace);
+                col += 1;
+            }
+        }
+        // Ā = C Z: row (q, e) of C picks Σ ŵ_i over constraint q's nodes at direction e; a rigid
+        // set's row j is column j of its V on its nodes.
         let mut a: DMatrix<f64> = DMatrix::zeros(m, m);
         for col in 0..m {
             let column = &z[col * n..(col + 1) * n];
@@ -95,13 +260,24 @@ impl ConstraintFactor {
                     a[(3 * q + e, col)] = c.free_sum(column, e);
                 }
             }
+            let mut row = points;
+            for set in rigid {
+                for j in 0..set.rows() {
+                    a[(row, col)] = set.free_dot(j, column);
+                    row += 1;
+                }
+            }
         }
         let a = (&a + a.transpose()) * 0.5;
-        let schur_inverse = a.cholesky().map(|c| c.inverse()).ok_or_else(|| {
-            Error::new(
-                "the pin constraints are redundant (their Schur complement is singular): two pins on the same nodes?",
-            )
-        })?;
+        let schur_inverse = match a.clone().cholesky() {
+            Some(c) => c.inverse(),
+            None if !rigid.is_empty() => redundant_inverse(a),
+            None => {
+                return Err(Error::new(
+                    "the pin constraints are redundant (their Schur complement is singular): two pins on the same nodes?",
+                ))
+            }
+        };
         Ok(ConstraintFactor {
             z,
             schur_inverse,
@@ -113,11 +289,15 @@ impl ConstraintFactor {
     /// One constrained correction, in place. On entry `reduced` holds `y = S̄⁻¹ hRᵀ (r + Cᵀλ)`
     /// on the free DOFs (the unconstrained correction is `Δx_u = −hR y`); on return it holds
     /// `y + Z μ`, so that the constrained correction is `Δx = −hR (y + Z μ)`, and `multipliers`
-    /// has been increased by `Δλ = hR_c μ` (global). `x` are the current positions, `r` the
-    /// rotation of the co-moving frame.
+    /// has been increased by `Δλ` (`hR_c μ` for the point constraints, global; `μ` for the rigid
+    /// sets, whose multipliers live in the set's frame). `x` are the current positions, `r` the
+    /// rotation of the co-moving frame. A rigid set's linearised error is
+    /// `h(x) − Vᵀ hR_sᵀ hR y ≈ h(x) − Vᵀ y` (its frame taken as the body's in the matrix only:
+    /// the residual and `h` are exact).
     pub fn correct(
         &mut self,
         constraints: &[PointConstraint],
+        rigid: &[RigidConstraint],
         x: &[f64],
         r: &Matrix3<f64>,
         reduced: &mut [f64],
@@ -134,6 +314,15 @@ impl ConstraintFactor {
             }
             let e = rt * (c.centroid(x) - c.target) - cu;
             self.error[3 * p..3 * p + 3].copy_from_slice(e.as_slice());
+        }
+        let mut row = 3 * constraints.len();
+        for set in rigid {
+            let k = set.rows();
+            set.violation(x, &mut self.error[row..row + k]);
+            for j in 0..k {
+                self.error[row + j] -= set.free_dot(j, reduced);
+            }
+            row += k;
         }
         for i in 0..m {
             self.mu[i] = (0..m)
@@ -152,11 +341,40 @@ impl ConstraintFactor {
                 multipliers[3 * p + d] += dl[d];
             }
         }
+        let points = 3 * constraints.len();
+        for (l, mu) in multipliers[points..m].iter_mut().zip(&self.mu[points..]) {
+            *l += mu;
+        }
     }
 }
 
-/// Adds the constraint forces `Cᵀλ` to `f` (flat `3N`).
-pub fn add_constraint_forces(constraints: &[PointConstraint], multipliers: &[f64], f: &mut [f64]) {
+/// The pseudo-inverse of a Schur complement whose constraints are redundant (a hinge or two pins
+/// on a rigid set hold one distance twice): the null directions are dropped, so the redundant
+/// multipliers share their load with the least norm; the forces are unique.
+fn redundant_inverse(a: DMatrix<f64>) -> DMatrix<f64> {
+    let eigen = a.symmetric_eigen();
+    let largest = eigen.eigenvalues.amax();
+    let inverse_values = eigen
+        .eigenvalues
+        .map(|v| if v > 1e-10 * largest { 1.0 / v } else { 0.0 });
+    &eigen.eigenvectors * DMatrix::from_diagonal(&inverse_values) * eigen.eigenvectors.transpose()
+}
+
+/// Adds the constraint forces `Cᵀλ` of the point constraints and the rigid sets to `f` (flat
+/// `3N`) at positions `x`.
+pub fn add_constraint_forces(
+    constraints: &[PointConstraint],
+    rigid: &[RigidConstraint],
+    x: &[f64],
+    multipliers: &[f64],
+    f: &mut [f64],
+) {
+    let mut row = 3 * constraints.len();
+    for set in rigid {
+        let k = set.rows();
+        set.add_force(x, &multipliers[row..row + k], f);
+        row += k;
+    }
     for (p, c) in constraints.iter().enumerate() {
         for (&n, &w) in c.nodes.iter().zip(&c.weights) {
             for d in 0..3 {

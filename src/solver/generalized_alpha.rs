@@ -219,11 +219,12 @@ impl IterationMatrix {
             )
         });
         let mut workspace = factor.solve_scratch();
-        let constraint = if free.constraints.is_empty() {
+        let constraint = if !free.is_constrained() {
             None
         } else {
             Some(ConstraintFactor::new(
                 &free.constraints,
+                &free.rigid,
                 &factor,
                 &mut workspace,
             )?)
@@ -486,6 +487,7 @@ impl IterationMatrix {
         if self.constraint.is_some() {
             self.constraint = Some(ConstraintFactor::new(
                 &free.constraints,
+                &free.rigid,
                 &self.factor,
                 &mut self.workspace,
             )?);
@@ -522,7 +524,14 @@ impl IterationMatrix {
         }
         if let Some(constraint) = &mut self.constraint {
             let (x, lambda) = (&state.position, &mut state.multipliers);
-            constraint.correct(&free.constraints, x, frame, &mut ws.reduced, lambda);
+            constraint.correct(
+                &free.constraints,
+                &free.rigid,
+                x,
+                frame,
+                &mut ws.reduced,
+                lambda,
+            );
         }
         let mut largest: f64 = 0.0;
         for (k, &i) in free.nodes.iter().enumerate() {

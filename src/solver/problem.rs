@@ -17,7 +17,7 @@
 //! discretises `ẋ`, `ẍ` in time and drives `r` to zero on the free DOFs; they all evaluate it
 //! with [`residual`] in a [`ResidualWorkspace`].
 
-use super::constraints::{add_constraint_forces, PointConstraint};
+use super::constraints::{add_constraint_forces, PointConstraint, RigidConstraint};
 use crate::body::{Body, BodyKinematics, ForceScratch};
 use crate::error::{Error, Result};
 use crate::linalg::SymmetricCsr;
@@ -37,6 +37,9 @@ pub struct FreeNodes {
     pub scalar_mass: SymmetricCsr,
     /// Point constraints (pins) on free nodes, solved with Lagrange multipliers.
     pub constraints: Vec<PointConstraint>,
+    /// Rigid sets (rigid attachments) of free nodes, with Lagrange multipliers after the point
+    /// constraints'.
+    pub rigid: Vec<RigidConstraint>,
 }
 
 impl FreeNodes {
@@ -54,6 +57,7 @@ impl FreeNodes {
             stiffness,
             scalar_mass,
             constraints: Vec::new(),
+            rigid: Vec::new(),
         }
     }
 
@@ -72,17 +76,7 @@ impl FreeNodes {
         target: nalgebra::Vector3<f64>,
     ) -> Result<()> {
         let total: f64 = weights.iter().sum();
-        let mut free_rows = Vec::with_capacity(nodes.len());
-        for &n in nodes {
-            match self.nodes.binary_search(&n) {
-                Ok(k) => free_rows.push(3 * k),
-                Err(_) => {
-                    return Err(Error::new(format!(
-                        "interface '{name}': node {n} is also held by a fixed support or motion interface"
-                    )))
-                }
-            }
-        }
+        let free_rows = self.free_rows(name, nodes)?;
         self.constraints.push(PointConstraint {
             nodes: nodes.to_vec(),
             weights: weights.iter().map(|w| w / total).collect(),
@@ -92,9 +86,35 @@ impl FreeNodes {
         Ok(())
     }
 
-    /// Number of Lagrange multipliers (3 per point constraint).
+    /// Makes the free nodes `nodes` one rigid set ([`RigidConstraint`]) with reference positions
+    /// `reference` (flat, all nodes). Error if a node is clamped or the nodes are collinear.
+    pub fn add_rigid_set(&mut self, name: &str, nodes: &[usize], reference: &[f64]) -> Result<()> {
+        let free_rows = self.free_rows(name, nodes)?;
+        self.rigid
+            .push(RigidConstraint::new(name, nodes, free_rows, reference)?);
+        Ok(())
+    }
+
+    fn free_rows(&self, name: &str, nodes: &[usize]) -> Result<Vec<usize>> {
+        nodes
+            .iter()
+            .map(|&n| match self.nodes.binary_search(&n) {
+                Ok(k) => Ok(3 * k),
+                Err(_) => Err(Error::new(format!(
+                    "interface '{name}': node {n} is also held by a fixed support or motion interface"
+                ))),
+            })
+            .collect()
+    }
+
+    /// Whether any Lagrange multiplier constraint (point or rigid set) is present.
+    pub fn is_constrained(&self) -> bool {
+        !self.constraints.is_empty() || !self.rigid.is_empty()
+    }
+
+    /// Number of Lagrange multipliers (3 per point constraint, `3n − 6` per rigid set).
     pub fn multiplier_count(&self) -> usize {
-        3 * self.constraints.len()
+        3 * self.constraints.len() + self.rigid.iter().map(RigidConstraint::rows).sum::<usize>()
     }
 
     /// Number of free DOFs.
@@ -253,7 +273,13 @@ pub fn residual(
     for k in 0..ws.internal.len() {
         ws.internal[k] += ws.inertia[k] - ws.external[k];
     }
-    add_constraint_forces(&free.constraints, &state.multipliers, &mut ws.internal);
+    add_constraint_forces(
+        &free.constraints,
+        &free.rigid,
+        &state.position,
+        &state.multipliers,
+        &mut ws.internal,
+    );
     kin
 }
 

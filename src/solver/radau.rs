@@ -101,7 +101,7 @@ impl StageConstraints {
         workspace: &mut SolveWorkspace,
         complex: &mut ComplexLu,
     ) -> Result<StageConstraints> {
-        let real_factor = ConstraintFactor::new(constraints, real, workspace)?;
+        let real_factor = ConstraintFactor::new(constraints, &[], real, workspace)?;
         let n = complex.dim();
         let m = 3 * constraints.len();
         let mut z = vec![c64::new(0.0, 0.0); n * m];
@@ -155,6 +155,11 @@ impl RadauMatrix {
         if body.full.is_some() {
             return Err(Error::new(
                 "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrix is the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
+            ));
+        }
+        if !free.rigid.is_empty() {
+            return Err(Error::new(
+                "solver.integrator = radauIIA does not support rigid attachments (\"rigid\": true on a force interface, pin or hinge); use generalizedAlpha",
             ));
         }
         let g = tableau.gamma / h;

@@ -26,6 +26,7 @@ pub fn initial_acceleration(
     forces.internal.iter_mut().for_each(|r| *r = -*r);
     mass.solve(
         free,
+        &state.position,
         &forces.internal,
         &mut state.acceleration,
         &mut state.multipliers,
@@ -68,6 +69,7 @@ pub fn restart_for_load_change(
     forces.inertia.fill(0.0);
     mass.solve(
         free,
+        &state.position,
         &forces.external,
         &mut forces.inertia,
         &mut ws.multiplier_change,
