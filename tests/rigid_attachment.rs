@@ -160,3 +160,137 @@ fn distance_from_rigid(reference: &[f64], x: &[f64], set: &[usize]) -> f64 {
         .map(|&i| (p(x, i) - c - r * (p(reference, i) - c0)).norm())
         .fold(0.0, f64::max)
 }
+
+/// The tumbling beam of B2 (free, no supports) with a lumped hub on a rigid face at x = 0.
+fn free_beam_with_hub(hub: bool) -> BodyFile {
+    let hub = if hub {
+        r#", "rigid": true, "mass": 2.5, "centerOfMass": [-0.05, 0.01, 0.0],
+        "inertia": [[0.02, 0.001, 0.0], [0.001, 0.03, -0.002], [0.0, -0.002, 0.025]]"#
+    } else {
+        ""
+    };
+    BodyFile::from_json(&format!(
+        r#"{{
+  "name": "hub",
+  "mesh": {{ "beam": {{ "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" }} }},
+  "material": {{ "youngsModulus": 2.1e11, "poissonRatio": 0.3, "density": 7850.0 }},
+  "interfaces": [
+    {{ "name": "hub", "kind": "force", "nodes": {{ "plane": {{ "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] }} }}, "referencePoint": [0.0, 0.0, 0.0]{hub} }}
+  ],
+  "solver": {{ "stepSize": 1e-3, "rhoInf": 1.0, "tolerance": 1e-12, "maxIterations": 50 }}
+}}"#
+    ))
+    .unwrap()
+}
+
+/// A lumped hub's inertia adds to the body's exactly: the body placed spinning at `ω` about
+/// the body file's origin has the kinetic energy and linear momentum of the beam plus
+/// `½ ωᵀ I_O ω` and `m ω × x_c` of the hub (`I_O` its inertia about the origin, which is the
+/// hub's reference point here): its six mass points carry its mass, centre and inertia.
+#[test]
+fn a_lumped_hub_adds_its_inertia_exactly() {
+    let omega = Vector3::new(0.3, -1.2, 2.0);
+    let spin = [
+        ("initial.angularVelocity[1]", omega.x),
+        ("initial.angularVelocity[2]", omega.y),
+        ("initial.angularVelocity[3]", omega.z),
+    ];
+    let mut with = initialized(free_beam_with_hub(true), &spin);
+    let mut without = initialized(free_beam_with_hub(false), &spin);
+    let (m, c) = (2.5, Vector3::new(-0.05, 0.01, 0.0));
+    let inertia = nalgebra::Matrix3::new(0.02, 0.001, 0.0, 0.001, 0.03, -0.002, 0.0, -0.002, 0.025);
+    let energy = get(&mut with, "body.kineticEnergy") - get(&mut without, "body.kineticEnergy");
+    let expected = 0.5 * omega.dot(&(inertia * omega));
+    let momentum =
+        vector(&mut with, "body.linearMomentum") - vector(&mut without, "body.linearMomentum");
+    println!("ΔT {energy:.15e} J against {expected:.15e} J; ΔP {momentum:?}");
+    assert!(
+        (energy - expected).abs() < 1e-12 * expected,
+        "{energy} J against {expected} J"
+    );
+    assert!((momentum - m * omega.cross(&c)).norm() < 1e-12 * m * omega.norm());
+}
+
+/// `1 + cos β cosh β + α β (cos β sinh β − sin β cosh β) − κ β³ (cosh β sin β + sinh β cos β)
+/// + α κ β⁴ (1 − cos β cosh β) = 0`: the frequency equation of an Euler–Bernoulli cantilever
+/// with a tip mass `α ρAL` and rotary inertia `κ ρAL³` (`ω = β² √(EI / ρAL⁴)`); its lowest root
+/// by bisection (checked against a shooting solution of `W'''' = β⁴ W` with the tip's shear and
+/// moment conditions: 1.24792 for `α = 1, κ = 0`, 1.87510 without a tip body).
+fn tip_mass_root(alpha: f64, kappa: f64) -> f64 {
+    let f = |b: f64| {
+        let (c, ch, s, sh) = (b.cos(), b.cosh(), b.sin(), b.sinh());
+        1.0 + c * ch + alpha * b * (c * sh - s * ch) - kappa * b.powi(3) * (ch * s + sh * c)
+            + alpha * kappa * b.powi(4) * (1.0 - c * ch)
+    };
+    let (mut lo, mut hi) = (0.1, 1.875104068711961);
+    let f_lo = f(lo);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if (f(mid) > 0.0) == (f_lo > 0.0) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// B1 with a tip body of its own mass (`α = 1`) and rotary inertia `κ = 0.01` (radius of
+/// gyration 0.1 m) on its rigid tip face: the first natural period is the Euler–Bernoulli
+/// beam's with a tip mass and rotary inertia within 0.5 %. Measured from the free vibration after
+/// a 1 N step load (mean period between upward crossings of the mid-line over seven periods,
+/// `ρ∞ = 1`, 256 steps per period: the scheme's period error is 5e-5): 0.32 % short; bare B1
+/// measured the same way is 0.36 % short of its Euler–Bernoulli period (the hex20 mesh and its
+/// clamped root face are a little stiff). Without the rotary inertia the analytic period would
+/// be 0.88 % shorter, without the tip mass 2.3 times shorter.
+#[test]
+fn a_cantilever_with_a_rigid_tip_mass_has_the_analytic_frequency() {
+    let (e, a, l, rho): (f64, f64, f64, f64) = (2.1e11, 0.02, 1.0, 7850.0);
+    let (ei, rho_a) = (e * a.powi(4) / 12.0, rho * a * a);
+    let (alpha, kappa) = (1.0, 0.01);
+    let (mass, j) = (alpha * rho_a * l, kappa * rho_a * l.powi(3));
+    let json = std::fs::read_to_string(format!("{}/examples/cantilever.json", env!("CARGO_MANIFEST_DIR")))
+        .unwrap()
+        .replace(
+            r#""referencePoint": [1.0, 0.0, 0.0] }"#,
+            &format!(
+                r#""referencePoint": [1.0, 0.0, 0.0], "rigid": true, "mass": {mass}, "inertia": [[{j}, 0, 0], [0, {j}, 0], [0, 0, {j}]] }}"#
+            ),
+        )
+        .replace(r#""rhoInf": 0.9"#, r#""rhoInf": 1.0"#);
+    assert!(json.contains(r#""mass""#));
+    let beta = tip_mass_root(alpha, kappa);
+    let omega = beta * beta * (ei / (rho_a * l.powi(4))).sqrt();
+    let period = 2.0 * std::f64::consts::PI / omega;
+    let h = period / 256.0;
+    let mut s = initialized(BodyFile::from_json(&json).unwrap(), &[]);
+    set(&mut s, "tip.force[2]", -1.0);
+    let steps = (8.5 * period / h) as usize;
+    let y: Vec<f64> = (0..steps)
+        .map(|k| {
+            s.do_step(k as f64 * h, h).unwrap();
+            get(&mut s, "tip.position[2]")
+        })
+        .collect();
+    let (lo, hi) = y
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    let mid = 0.5 * (lo + hi);
+    let crossings: Vec<f64> = (1..steps)
+        .filter(|&k| y[k - 1] < mid && y[k] >= mid)
+        .map(|k| (k as f64 + (mid - y[k - 1]) / (y[k] - y[k - 1])) * h)
+        .collect();
+    let measured = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    println!(
+        "β = {beta:.6}, period {period:.6e} s (α = 0: {:.6e} s, κ = 0: {:.6e} s); measured {measured:.6e} s over {} periods ({:+.3} %)",
+        2.0 * std::f64::consts::PI / (tip_mass_root(0.0, 0.0).powi(2) * (ei / (rho_a * l.powi(4))).sqrt()),
+        2.0 * std::f64::consts::PI / (tip_mass_root(alpha, 0.0).powi(2) * (ei / (rho_a * l.powi(4))).sqrt()),
+        crossings.len() - 1,
+        100.0 * (measured / period - 1.0)
+    );
+    assert!(crossings.len() >= 8, "{crossings:?}");
+    assert!(
+        (measured - period).abs() < 5e-3 * period,
+        "{measured} s against {period} s"
+    );
+}

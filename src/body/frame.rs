@@ -72,14 +72,15 @@ pub struct Frame {
 }
 
 impl FrameWeights {
-    /// `nodes` with positive `weights`, reference positions taken from `reference` (flat `3N`).
+    /// `nodes` with non-negative `weights` of positive sum (a lumped body's mass points weigh
+    /// nothing in the body frame), reference positions taken from `reference` (flat `3N`).
     pub fn new(nodes: Vec<usize>, weights: Vec<f64>, reference: &[f64]) -> FrameWeights {
         assert_eq!(nodes.len(), weights.len());
-        assert!(
-            weights.iter().all(|&w| w > 0.0),
-            "frame weights must be positive"
-        );
         let total_weight: f64 = weights.iter().sum();
+        assert!(
+            weights.iter().all(|&w| w >= 0.0) && total_weight > 0.0,
+            "frame weights must be non-negative with a positive sum"
+        );
         let mut centroid = Vector3::zeros();
         for (&n, &w) in nodes.iter().zip(&weights) {
             centroid += w * node(reference, n);

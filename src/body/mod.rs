@@ -5,6 +5,7 @@
 pub mod feature_indicators;
 pub mod frame;
 pub mod interface;
+pub mod lumped_body;
 pub mod patches;
 pub mod reduction;
 pub mod stiffening;
@@ -12,6 +13,7 @@ pub mod strain_monitor;
 
 pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
+pub use lumped_body::LumpedBody;
 pub use patches::Patches;
 pub use reduction::{ModeChoice, ModeCount, Reduction};
 
@@ -84,6 +86,9 @@ pub struct Body {
     /// correction of `f_nl` (computed once per step size) even while the term is off, so that
     /// switching it on needs no new factorization.
     pub nonlinear_forces_switchable: bool,
+    /// The last `lumped_points` nodes are the mass points of lumped bodies (no stiffness, no
+    /// weight in the co-moving frame; docs/formulation.md, "Rigid attachments").
+    pub lumped_points: usize,
 }
 
 /// How a constant `3N × 3N` matrix is stored for the products of the hot path.
@@ -178,6 +183,7 @@ impl Body {
             patches: None,
             reduction: None,
             nonlinear_forces_switchable: false,
+            lumped_points: 0,
         }
     }
 
@@ -206,6 +212,7 @@ impl Body {
             patches: None,
             reduction: Some(Box::new(reduction)),
             nonlinear_forces_switchable: false,
+            lumped_points: 0,
         }
     }
 

@@ -213,6 +213,13 @@ impl Patches {
         })
     }
 
+    /// The patches of a body with `total` nodes, the mesh's and after them a lumped body's mass
+    /// points, which belong to no patch (no stiffness): their rows turn with the first patch.
+    pub fn covering(mut self, total: usize) -> Patches {
+        self.node_patch.resize(total, 0);
+        self
+    }
+
     /// Number of patches.
     pub fn len(&self) -> usize {
         self.patches.len()

@@ -49,6 +49,22 @@ impl SymmetricCsr {
         }
     }
 
+    /// The matrix with `diagonal.len()` more rows and columns, each holding only its diagonal
+    /// entry `diagonal[k]` (a zero keeps the row empty): the extra nodes of a body without
+    /// stiffness and with a point mass.
+    pub fn extended(&self, diagonal: &[f64]) -> SymmetricCsr {
+        let mut extended = self.clone();
+        for (k, &d) in diagonal.iter().enumerate() {
+            if d != 0.0 {
+                extended.col_idx.push(self.n + k);
+                extended.values.push(d);
+            }
+            extended.row_ptr.push(extended.col_idx.len());
+        }
+        extended.n += diagonal.len();
+        extended
+    }
+
     /// `y = A x`. No allocation. Panics if the lengths are not `n`.
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         assert_eq!(

@@ -181,6 +181,16 @@ pub struct InterfaceSpec {
     /// clamp their set rigidly anyway.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub rigid: bool,
+    /// A lumped rigid body carried by a rigid attachment: its mass (kg)...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<f64>,
+    /// ...its inertia tensor about the reference point in body axes (kg m², rows; default 0: a
+    /// point mass)...
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<[[f64; 3]; 3]>,
+    /// ...and its centre of mass (m, body coordinates; default the reference point).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub center_of_mass: Option<[f64; 3]>,
 }
 
 /// Solver defaults (the FMU's `solver.*` parameters start here).

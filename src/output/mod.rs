@@ -98,13 +98,14 @@ impl ResultWriter {
         // The frame of the body's coordinates; a reduced body's nodes are `x_i = Σ_k S_ik q_k`.
         let frame = body.frame_weights.best_fit(x);
         let centroid = body.frame_weights.reference_centroid;
+        // The mesh's nodes: a lumped body's mass points (after them) are not drawn.
         let (expanded, reference) = match &body.reduction {
-            Some(r) => ((r.expand(x), r.expand(v)), &r.mesh_reference),
-            None => ((Vec::new(), Vec::new()), &body.reference),
+            Some(r) => ((r.expand(x), r.expand(v)), &r.mesh_reference[..]),
+            None => ((Vec::new(), Vec::new()), &body.reference[..3 * n]),
         };
         let (x, v) = match &body.reduction {
             Some(_) => (&expanded.0[..], &expanded.1[..]),
-            None => (x, v),
+            None => (&x[..3 * n], &v[..3 * n]),
         };
         let displacement: Vec<f64> = x.iter().zip(reference).map(|(a, b)| a - b).collect();
         let mut deformation = vec![0.0; 3 * n];

@@ -348,23 +348,34 @@ pub(super) fn interfaces_of(
     body_file: &BodyFile,
     mesh: &Mesh,
     size: f64,
-) -> Result<(Vec<Interface>, Vec<bool>)> {
-    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+) -> Result<(Vec<Interface>, Vec<bool>, Vec<MassPoint>)> {
+    let mut reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
     let lumped = fem::lumped_masses(mesh, 1.0);
     let mut interfaces = Vec::new();
     let mut clamped = vec![false; mesh.node_count()];
+    let mut mass_points = Vec::new();
     for spec in &body_file.interfaces {
-        let nodes = spec
+        let mut nodes = spec
             .nodes
             .select(mesh)
             .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
-        let weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
+        let mut weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
+        let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
+        // A lumped body joins the set as six mass points (docs/formulation.md, "Rigid
+        // attachments"), weighted like an average node of the set.
+        for (position, mass) in lumped_body_points(spec, &nodes, &weights, &reference)? {
+            let index = reference.len() / 3;
+            reference.extend_from_slice(position.as_slice());
+            weights.push(weights.iter().sum::<f64>() / weights.len() as f64);
+            nodes.push(index);
+            clamped.push(false);
+            mass_points.push(MassPoint { position, mass });
+        }
         if matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion) {
             for &i in &nodes {
                 clamped[i] = true;
             }
         }
-        let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
         let set = NodeSet::new(
             &spec.name,
             nodes,
@@ -384,7 +395,62 @@ pub(super) fn interfaces_of(
             "body file: fixed supports hold every node: nothing can move",
         ));
     }
-    Ok((interfaces, clamped))
+    Ok((interfaces, clamped, mass_points))
+}
+
+/// A point mass of a lumped body (docs/formulation.md, "Rigid attachments"): an extra node of
+/// the body after the mesh's, without stiffness.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct MassPoint {
+    /// Reference position (m).
+    pub(super) position: Vector3<f64>,
+    /// Mass (kg).
+    pub(super) mass: f64,
+}
+
+/// The mass points of `spec`'s lumped body (none without `mass`). Its reference point is the
+/// interface's (the weighted centroid of `nodes` if not given). Error if the interface cannot
+/// carry one: a lumped body needs a rigid set (`"rigid": true`, or a fixed support or motion
+/// interface, which are rigid anyway).
+fn lumped_body_points(
+    spec: &crate::model::InterfaceSpec,
+    nodes: &[usize],
+    weights: &[f64],
+    reference: &[f64],
+) -> Result<Vec<(Vector3<f64>, f64)>> {
+    let Some(mass) = spec.mass else {
+        if spec.inertia.is_some() || spec.center_of_mass.is_some() {
+            return Err(Error::new(format!(
+                "interface '{}': inertia and centerOfMass describe a lumped body and need its \"mass\"",
+                spec.name
+            )));
+        }
+        return Ok(Vec::new());
+    };
+    let rigid = spec.rigid || matches!(spec.kind, InterfaceKind::Fixed | InterfaceKind::Motion);
+    if !rigid {
+        return Err(Error::new(format!(
+            "interface '{}': a lumped body (mass {mass} kg) needs a rigid set to ride on: add \"rigid\": true",
+            spec.name
+        )));
+    }
+    let total: f64 = weights.iter().sum();
+    let centroid = nodes
+        .iter()
+        .zip(weights)
+        .fold(Vector3::zeros(), |c, (&i, w)| {
+            c + *w / total * node(reference, i)
+        });
+    let point = spec.reference_point.map_or(centroid, Vector3::from);
+    let body = crate::body::LumpedBody {
+        mass,
+        center_of_mass: spec.center_of_mass.map_or(point, Vector3::from),
+        inertia: spec
+            .inertia
+            .map_or(Matrix3::zeros(), |rows| Matrix3::from_fn(|i, j| rows[i][j])),
+        point,
+    };
+    body.mass_points(&spec.name)
 }
 
 /// The inputs of a fresh instance: motion interfaces at their place in the body file, at rest;

@@ -116,6 +116,8 @@ pub struct Slave {
     /// Node sets, and `clamped[i]` for nodes held by a `fixed` support.
     interfaces: Vec<Interface>,
     clamped: Vec<bool>,
+    /// The point masses of the interfaces' lumped bodies, the body's nodes after the mesh's.
+    mass_points: Vec<interfaces::MassPoint>,
     /// The material region of each element (`BodyFile::regions`), `None`: `material.*`.
     element_regions: Vec<Option<usize>>,
     /// Characteristic size of the body (m): the diagonal of its bounding box.
@@ -205,7 +207,7 @@ impl Slave {
         let mesh = body_file.mesh.build(base_dir)?;
         let (lo, hi) = mesh.bounding_box();
         let size = (Vector3::from(hi) - Vector3::from(lo)).norm();
-        let (interfaces, clamped) = interfaces_of(&body_file, &mesh, size)?;
+        let (interfaces, clamped, mass_points) = interfaces_of(&body_file, &mesh, size)?;
         let variables = VariableTable::new(&body_file.interfaces);
         let defaults = Parameters::from_body_file(&body_file);
         for v in variables.iter() {
@@ -228,6 +230,7 @@ impl Slave {
             mesh,
             interfaces,
             clamped,
+            mass_points,
             element_regions,
             size,
             parameters: defaults.clone(),

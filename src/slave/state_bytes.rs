@@ -329,7 +329,7 @@ impl Slave {
             1 => {
                 let time = r.f64("the time")?;
                 let n3 = if p.modes == 0 {
-                    let n3 = 3 * self.mesh.node_count();
+                    let n3 = 3 * (self.mesh.node_count() + self.mass_points.len());
                     r.count(n3, "position coordinates")?;
                     n3
                 } else {

@@ -40,12 +40,17 @@ pub struct FreeNodes {
     /// Rigid sets (rigid attachments) of free nodes, with Lagrange multipliers after the point
     /// constraints'.
     pub rigid: Vec<RigidConstraint>,
+    /// The first `elastic_nodes` free nodes are the mesh's; the others are lumped bodies' mass
+    /// points (no stiffness).
+    pub elastic_nodes: usize,
 }
 
 impl FreeNodes {
     /// Free nodes of `body` when `clamped` nodes are held.
     pub fn new(body: &Body, clamped: &[bool]) -> FreeNodes {
         let nodes: Vec<usize> = (0..body.node_count()).filter(|&i| !clamped[i]).collect();
+        let mesh_nodes = body.node_count() - body.lumped_points;
+        let elastic_nodes = nodes.iter().filter(|&&i| i < mesh_nodes).count();
         let dofs = node_dofs(&nodes);
         let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
         let stiffness = body.stiffness_matrix.submatrix(&dofs);
@@ -58,7 +63,19 @@ impl FreeNodes {
             scalar_mass,
             constraints: Vec::new(),
             rigid: Vec::new(),
+            elastic_nodes,
         }
+    }
+
+    /// `K` and `M ⊗ I3` on the free mesh nodes' DOFs (without the lumped bodies' mass points,
+    /// whose zero stiffness would add zero frequencies): what a modal analysis of the elastic
+    /// body takes.
+    pub fn elastic_matrices(&self) -> (SymmetricCsr, SymmetricCsr) {
+        let dofs: Vec<usize> = (0..3 * self.elastic_nodes).collect();
+        if dofs.len() == self.stiffness.n {
+            return (self.stiffness.clone(), self.mass.clone());
+        }
+        (self.stiffness.submatrix(&dofs), self.mass.submatrix(&dofs))
     }
 
     /// The global DOFs of the free nodes, in the order of the reduced system.
