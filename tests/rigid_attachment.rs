@@ -294,3 +294,29 @@ fn a_cantilever_with_a_rigid_tip_mass_has_the_analytic_frequency() {
         "{measured} s against {period} s"
     );
 }
+
+/// A hinge on a rigid set holds the distance between its two points twice: refused, naming
+/// the interfaces and what to do instead.
+#[test]
+fn a_hinge_on_a_rigid_set_is_refused_by_name() {
+    let json = std::fs::read_to_string(format!(
+        "{}/examples/controlled_arm.json",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+    .replace(
+        r#""min": [0.1, -1.0, -1.0], "max": [0.3, 1.0, 1.0]"#,
+        r#""min": [0.0, -1.0, -1.0], "max": [0.3, 1.0, 1.0]"#,
+    );
+    let mut s = Slave::from_body(BodyFile::from_json(&json).unwrap()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(
+        e.message.contains("interface 'hub'")
+            && e.message.contains("'bearing'")
+            && e.message.contains("hinge"),
+        "{}",
+        e.message
+    );
+}

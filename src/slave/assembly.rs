@@ -544,6 +544,7 @@ impl Slave {
                 )?;
             }
         }
+        self.check_held_points_on_rigid_sets()?;
         for (k, interface) in self.interfaces.iter_mut().enumerate() {
             interface.first_constraint = free.constraints.len();
             for (nodes, weights) in &interface.point_constraints {
@@ -557,6 +558,43 @@ impl Slave {
             }
         }
         Ok(free)
+    }
+
+    /// A rigid set may carry one held point (a pin): a hinge's two points, or two pins, on one
+    /// rigid set would hold the distance between them twice (the constraints are redundant and
+    /// the iteration stalls on the conflict between their linearisations). Error naming both
+    /// interfaces.
+    fn check_held_points_on_rigid_sets(&self) -> Result<()> {
+        let specs = &self.body_file.interfaces;
+        for (rigid, rigid_spec) in self.interfaces.iter().zip(specs) {
+            let is_rigid_set = rigid_spec.rigid
+                && matches!(
+                    rigid.kind,
+                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                );
+            if !is_rigid_set {
+                continue;
+            }
+            let nodes = &rigid.set.frame_weights.nodes;
+            let mut held = Vec::new();
+            for (interface, spec) in self.interfaces.iter().zip(specs) {
+                for (points, _) in &interface.point_constraints {
+                    if points.iter().any(|n| nodes.contains(n)) {
+                        held.push(format!("'{}'", spec.name));
+                    }
+                }
+            }
+            if held.len() > 1 {
+                let count = held.len();
+                held.dedup();
+                return Err(Error::new(format!(
+                    "interface '{}': its rigid set is held at {count} points (by {}; a hinge holds two), which holds the distance between them twice; a rigid set may be held at one point: put the hinge on nodes outside the rigid set (e.g. the face next to it), or hold the set with a pin",
+                    rigid_spec.name,
+                    held.join(", ")
+                )));
+            }
+        }
+        Ok(())
     }
 
     /// `model.auto`'s indicators for the allowed terms of the one-frame reduced-strain body on

@@ -269,15 +269,13 @@ impl ConstraintFactor {
             }
         }
         let a = (&a + a.transpose()) * 0.5;
-        let schur_inverse = match a.clone().cholesky() {
-            Some(c) => c.inverse(),
-            None if !rigid.is_empty() => redundant_inverse(a),
-            None => {
-                return Err(Error::new(
-                    "the pin constraints are redundant (their Schur complement is singular): two pins on the same nodes?",
-                ))
-            }
-        };
+        let schur_inverse = a.cholesky().map(|c| c.inverse()).ok_or_else(|| {
+            Error::new(if rigid.is_empty() {
+                "the pin constraints are redundant (their Schur complement is singular): two pins on the same nodes?"
+            } else {
+                "the pin, hinge and rigid-set constraints are redundant (their Schur complement is singular): two rigid interfaces on the same nodes?"
+            })
+        })?;
         Ok(ConstraintFactor {
             z,
             schur_inverse,
@@ -346,18 +344,6 @@ impl ConstraintFactor {
             *l += mu;
         }
     }
-}
-
-/// The pseudo-inverse of a Schur complement whose constraints are redundant (a hinge or two pins
-/// on a rigid set hold one distance twice): the null directions are dropped, so the redundant
-/// multipliers share their load with the least norm; the forces are unique.
-fn redundant_inverse(a: DMatrix<f64>) -> DMatrix<f64> {
-    let eigen = a.symmetric_eigen();
-    let largest = eigen.eigenvalues.amax();
-    let inverse_values = eigen
-        .eigenvalues
-        .map(|v| if v > 1e-10 * largest { 1.0 / v } else { 0.0 });
-    &eigen.eigenvectors * DMatrix::from_diagonal(&inverse_values) * eigen.eigenvectors.transpose()
 }
 
 /// Adds the constraint forces `Cᵀλ` of the point constraints and the rigid sets to `f` (flat

@@ -74,3 +74,19 @@ def conrod_fmu_path() -> str:
 def fmu3_path() -> str:
     """The default body as an FMI 3.0 FMU (``cargo xtask fmu --fmi 3``)."""
     return _packaged_fmu("FLEXBODY_FMU3", "cantilever-fmi3.fmu", "cargo xtask fmu --fmi 3")
+
+
+@pytest.fixture(scope="session")
+def arm_fmu_path() -> str:
+    """Kane's beam on a hinge with a rigid hub that takes a motor torque (examples/controlled_arm.json)."""
+    return _packaged_fmu("FLEXBODY_ARM_FMU", "controlled_arm.fmu", "cargo xtask fmu --body examples/controlled_arm.json")
+
+
+@pytest.fixture(scope="session")
+def arm_model_description(arm_fmu_path):
+    return read_model_description(arm_fmu_path)
+
+
+@pytest.fixture(scope="session")
+def arm_unzipdir(arm_fmu_path, tmp_path_factory) -> str:
+    return extract(arm_fmu_path, unzipdir=str(tmp_path_factory.mktemp("arm_fmu")))

@@ -9,7 +9,8 @@
 //!   library's Rust tests cross-built for win64 and run under wine, then the default FMU
 //!   (linux64 and win64; the win64 DLL's imports checked to be Windows' own), the driven cantilever's FMU (`examples/driven_cantilever.json`), the pinned
 //!   Python environment (`<target>/venv`) and `pytest tests/python` with the FMUs' paths in
-//!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU` and `FLEXBODY_CONROD_FMU` (`examples/conrod.json`).
+//!   `FLEXBODY_FMU`, `FLEXBODY_DRIVEN_FMU`, `FLEXBODY_CONROD_FMU` (`examples/conrod.json`) and
+//!   `FLEXBODY_ARM_FMU` (`examples/controlled_arm.json`).
 //! * `demo`: the default FMU driven by fmpy (`tests/python/demo.py`): a step load on the
 //!   cantilever's tip, a table, the comparison with the Timoshenko deflection and a PNG plot.
 //!
@@ -157,6 +158,7 @@ fn test_task(args: &[String]) -> Result<()> {
     let host = [fmu::host_platform()?];
     let driven_fmu = workspace.build_fmu(Some(&workspace.driven_body()), None, &host, 2)?;
     let conrod_fmu = workspace.build_fmu(Some(&workspace.conrod_body()), None, &host, 2)?;
+    let arm_fmu = workspace.build_fmu(Some(&workspace.arm_body()), None, &host, 2)?;
     // The win64 DLL is also run under wine by fmpy's remoting server (tests/python/test_win64.py),
     // with the stand-in for wine 8.0's missing bcryptprimitives.dll beside the server.
     let wine64 = fmu::ensure_wine64()?;
@@ -178,6 +180,7 @@ fn test_task(args: &[String]) -> Result<()> {
         .env("FLEXBODY_WINE_STAND_IN", &stand_in)
         .env("FLEXBODY_DRIVEN_FMU", &driven_fmu)
         .env("FLEXBODY_CONROD_FMU", &conrod_fmu)
+        .env("FLEXBODY_ARM_FMU", &arm_fmu)
         .env("MPLBACKEND", "Agg");
     run(&mut pytest)
 }
@@ -338,6 +341,11 @@ impl Workspace {
     /// The connecting rod (Gmsh tet10 mesh in resources/, motion and force interfaces on its eyes).
     pub fn conrod_body(&self) -> PathBuf {
         self.root.join("examples").join("conrod.json")
+    }
+
+    /// Kane's beam on a hinge with a rigid hub (`tests/python/controlled_arm.py`'s FMU).
+    pub fn arm_body(&self) -> PathBuf {
+        self.root.join("examples").join("controlled_arm.json")
     }
 
     /// Builds and packages the FMI `fmi` (2 or 3) FMU with the binaries of `platforms`;
