@@ -557,13 +557,25 @@ impl Slave {
                 )?;
             }
         }
+        for k in 0..self.interfaces.len() {
+            if let Some(rigid) = self.interfaces[k].locks {
+                let spec = &self.body_file.interfaces[k];
+                self.interfaces[k].lock_constraint = free.rigid.len();
+                free.add_axis_lock(
+                    &spec.name,
+                    &self.interfaces[rigid].set.frame_weights.nodes,
+                    &body.reference,
+                    Vector3::from(spec.axis.unwrap_or_default()),
+                )?;
+            }
+        }
         Ok(free)
     }
 
-    /// A rigid set may carry one held point (a pin): a hinge's two points, or two pins, on one
-    /// rigid set would hold the distance between them twice (the constraints are redundant and
-    /// the iteration stalls on the conflict between their linearisations). Error naming both
-    /// interfaces.
+    /// A rigid set may carry one held point (a pin, or a hinge, which on a rigid set holds the
+    /// set's centroid and locks its rotation to the axis): two on one rigid set would hold the
+    /// distance between them twice (the constraints are redundant and the iteration stalls on
+    /// the conflict between their linearisations). Error naming the interfaces.
     fn check_held_points_on_rigid_sets(&self) -> Result<()> {
         let specs = &self.body_file.interfaces;
         for (rigid, rigid_spec) in self.interfaces.iter().zip(specs) {
@@ -588,7 +600,7 @@ impl Slave {
                 let count = held.len();
                 held.dedup();
                 return Err(Error::new(format!(
-                    "interface '{}': its rigid set is held at {count} points (by {}; a hinge holds two), which holds the distance between them twice; a rigid set may be held at one point: put the hinge on nodes outside the rigid set (e.g. the face next to it), or hold the set with a pin",
+                    "interface '{}': its rigid set is held at {count} points (by {}), which holds the distance between them twice; a rigid set may be held by one pin or one hinge (which holds the set's centroid and locks its rotation to the axis)",
                     rigid_spec.name,
                     held.join(", ")
                 )));

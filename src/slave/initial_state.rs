@@ -214,6 +214,9 @@ impl Slave {
         placement: &RigidPlacement,
     ) -> Result<()> {
         let model = self.model.as_mut().unwrap();
+        for lock in &mut model.free.rigid {
+            lock.place(&state.position);
+        }
         let (v0, w0) = (placement.velocity, placement.angular_velocity);
         for (k, interface) in self.interfaces.iter().enumerate() {
             let first = interface.first_constraint;

@@ -24,6 +24,13 @@ pub(super) struct Interface {
     pub(super) point_constraints: Vec<(Vec<usize>, Vec<f64>)>,
     /// Index of the first of them in the solver's constraint list.
     pub(super) first_constraint: usize,
+    /// A hinge on a rigid set (its own, or that of the interface with this index): one point
+    /// constraint on the whole set's centroid and an axis lock on the rigid set
+    /// (`RigidConstraint::axis_lock`) instead of the two half-centroids, which would hold the
+    /// rigid distance between them twice.
+    pub(super) locks: Option<usize>,
+    /// The index of its axis lock in the solver's rigid constraints.
+    pub(super) lock_constraint: usize,
 }
 
 /// The point constraints of a pin (the whole set) or a hinge (the two halves of the set on either
@@ -245,6 +252,7 @@ impl Slave {
                     } else {
                         0
                     }
+                    + if i.locks.is_some() { 2 } else { 0 }
             })
             .sum()
     }
@@ -354,6 +362,7 @@ pub(super) fn interfaces_of(
     let mut interfaces = Vec::new();
     let mut clamped = vec![false; mesh.node_count()];
     let mut mass_points = Vec::new();
+    let mut whole_sets = Vec::new();
     for spec in &body_file.interfaces {
         let mut nodes = spec
             .nodes
@@ -361,6 +370,7 @@ pub(super) fn interfaces_of(
             .map_err(|e| Error::new(format!("interface '{}': {}", spec.name, e.message)))?;
         let mut weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
         let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
+        whole_sets.push((nodes.clone(), weights.clone()));
         // A lumped body joins the set as six mass points (docs/formulation.md, "Rigid
         // attachments"), weighted like an average node of the set.
         for (position, mass) in lumped_body_points(spec, &nodes, &weights, &reference)? {
@@ -388,7 +398,47 @@ pub(super) fn interfaces_of(
             set,
             point_constraints,
             first_constraint: 0,
+            locks: None,
+            lock_constraint: 0,
         });
+    }
+    // A hinge on a rigid set: the whole set's centroid and an axis lock.
+    let rigid_sets: Vec<Option<&[usize]>> = interfaces
+        .iter()
+        .zip(&body_file.interfaces)
+        .map(|(i, spec)| {
+            (spec.rigid
+                && matches!(
+                    i.kind,
+                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                ))
+            .then_some(&i.set.frame_weights.nodes[..])
+        })
+        .collect();
+    let locks: Vec<Option<usize>> = interfaces
+        .iter()
+        .map(|hinge| {
+            (hinge.kind == InterfaceKind::Hinge)
+                .then(|| {
+                    rigid_sets.iter().position(|set| {
+                        set.is_some_and(|set| {
+                            hinge
+                                .set
+                                .frame_weights
+                                .nodes
+                                .iter()
+                                .any(|n| set.contains(n))
+                        })
+                    })
+                })
+                .flatten()
+        })
+        .collect();
+    for ((interface, lock), whole) in interfaces.iter_mut().zip(locks).zip(whole_sets) {
+        if lock.is_some() {
+            interface.point_constraints = vec![whole];
+            interface.locks = lock;
+        }
     }
     if clamped.iter().all(|&c| c) {
         return Err(Error::new(

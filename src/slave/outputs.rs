@@ -233,6 +233,14 @@ fn interface_outputs(
                 force += f;
                 torque += (constraint.centroid(&state.position) - p).cross(&f);
             }
+            if interface.locks.is_some() {
+                // A hinge on a rigid set: the bearing's moment, from its axis lock.
+                let lock = interface.lock_constraint;
+                let first = 3 * free.constraints.len()
+                    + free.rigid[..lock].iter().map(|r| r.rows()).sum::<usize>();
+                let m = &state.multipliers[first..first + free.rigid[lock].rows()];
+                torque -= free.rigid[lock].moment(&state.position, m, &p);
+            }
             put(out, Q::Force, force.as_slice());
             put(out, Q::Torque, torque.as_slice());
         }

@@ -148,8 +148,8 @@ impl ConsistentAcceleration {
     }
 
     /// `a ← a − M⁻¹ Cᵀ λ`, `λ = (C M⁻¹ Cᵀ)⁺ C a` with the point constraints' and the rigid sets'
-    /// rows at positions `x` (the pseudo-inverse: a hinge on a rigid set holds one distance
-    /// twice). Allocates (initialization only).
+    /// rows at positions `x` (a pseudo-inverse, for rows that are dependent at this
+    /// configuration). Allocates (initialization only).
     fn project_with_rigid_sets(
         &mut self,
         free: &FreeNodes,

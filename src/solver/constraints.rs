@@ -66,6 +66,14 @@ impl PointConstraint {
 /// `∂h/∂x = Vᵀ hR_sᵀ` (the best fit takes the rigid part out of `δū`): constant in the set's
 /// frame, like the body's stiffness. The constraint force `hR_s V λ` has no resultant and no
 /// moment (`V` is orthogonal to the rigid motions): it holds the shape and nothing else.
+///
+/// An axis lock on a rigid set (a hinge on it) holds instead the set's rotation about every
+/// axis but the hinge's: `h_j = b_jᵀ R_sᵀ a = 0`, `j = 1, 2`, with `a` the hinge axis (global) and
+/// `b_1`, `b_2` perpendicular to its reference direction `a_ref` (`a = R_s a_ref` at placement).
+/// With `δR_s = R_s [δθ]×` and the best fit's `δθ = J̄⁻¹ Σ_i X̂_i × δx̂_i`
+/// (`J̄ = Σ_i (|X̂_i|² 1 − X̂_i X̂_iᵀ)`), `δh_j = −δθ · (a_ref × b_j)`: the rows
+/// `g_j,i = −(J̄⁻¹ (a_ref × b_j)) × X̂_i` are constant in the set's frame, and the force
+/// `hR_s g λ` is a pure moment about axes perpendicular to the hinge's (the bearing's moment).
 #[derive(Debug, Clone)]
 pub struct RigidConstraint {
     /// Global node indices.
@@ -74,8 +82,21 @@ pub struct RigidConstraint {
     pub free_rows: Vec<usize>,
     /// `X̂_i = X_i − X̄` (m), the reference offsets from the set's centroid.
     pub offsets: Vec<Vector3<f64>>,
-    /// `V`, column-major (`k` columns of `3n`).
+    /// `V` (the shape), or the rows `g_j` of an axis lock, column-major (`k` columns of `3n`).
     pub basis: Vec<f64>,
+    /// An axis lock's directions, in place of the shape constraint.
+    pub lock: Option<AxisLock>,
+}
+
+/// The directions of an axis lock ([`RigidConstraint`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisLock {
+    /// `b_1`, `b_2`: perpendicular to the hinge axis in reference coordinates.
+    pub directions: [Vector3<f64>; 2],
+    /// `a_ref`, the hinge axis in reference coordinates (unit).
+    pub reference_axis: Vector3<f64>,
+    /// `a`, the hinge axis in global coordinates (unit): `R_s a_ref` where the body was placed.
+    pub axis: Vector3<f64>,
 }
 
 impl RigidConstraint {
@@ -130,12 +151,69 @@ impl RigidConstraint {
             free_rows,
             offsets,
             basis,
+            lock: None,
         })
     }
 
-    /// `k = 3n − 6`, the number of multipliers.
+    /// The axis lock of a hinge with reference axis `axis` on the rigid set of `nodes` (see the
+    /// type's documentation); its global axis is `axis` until [`Self::place`] sets it.
+    pub fn axis_lock(
+        name: &str,
+        nodes: &[usize],
+        free_rows: Vec<usize>,
+        reference: &[f64],
+        axis: Vector3<f64>,
+    ) -> Result<Self> {
+        let shape = RigidConstraint::new(name, nodes, free_rows, reference)?;
+        let a = axis.normalize();
+        let helper = if a.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
+        let b1 = a.cross(&helper).normalize();
+        let b2 = a.cross(&b1);
+        let polar = shape.offsets.iter().fold(Matrix3::zeros(), |j, o| {
+            j + Matrix3::identity() * o.norm_squared() - o * o.transpose()
+        });
+        let polar_inverse = polar.try_inverse().ok_or_else(|| {
+            Error::new(format!(
+                "interface '{name}': the rigid set cannot carry a moment"
+            ))
+        })?;
+        let mut basis = Vec::with_capacity(6 * nodes.len());
+        for b in [b1, b2] {
+            let arm = polar_inverse * a.cross(&b);
+            for o in &shape.offsets {
+                basis.extend((-arm.cross(o)).iter());
+            }
+        }
+        Ok(RigidConstraint {
+            basis,
+            lock: Some(AxisLock {
+                directions: [b1, b2],
+                reference_axis: a,
+                axis: a,
+            }),
+            ..shape
+        })
+    }
+
+    /// Sets an axis lock's global axis from the positions `x` where the body was placed.
+    pub fn place(&mut self, x: &[f64]) {
+        let r = self.rotation(x);
+        if let Some(lock) = &mut self.lock {
+            lock.axis = r * lock.reference_axis;
+        }
+    }
+
+    /// The number of multipliers: `k = 3n − 6` for the shape, 2 for an axis lock.
     pub fn rows(&self) -> usize {
-        3 * self.nodes.len() - 6
+        if self.lock.is_some() {
+            2
+        } else {
+            3 * self.nodes.len() - 6
+        }
     }
 
     /// Column `j` of `V` (`3n`).
@@ -161,10 +239,17 @@ impl RigidConstraint {
         self.nodes.iter().map(|&i| node(x, i)).sum::<Vector3<f64>>() / self.nodes.len() as f64
     }
 
-    /// `h(x) = Vᵀ ū` into `h` (`k`); returns `R_s`.
+    /// `h(x) = Vᵀ ū` (or an axis lock's `b_jᵀ R_sᵀ a`) into `h` (`k`); returns `R_s`.
     pub fn violation(&self, x: &[f64], h: &mut [f64]) -> Matrix3<f64> {
         let (c, r) = (self.centroid(x), self.rotation(x));
         let rt = r.transpose();
+        if let Some(lock) = &self.lock {
+            let local_axis = rt * lock.axis;
+            for (hj, b) in h.iter_mut().zip(&lock.directions) {
+                *hj = b.dot(&local_axis);
+            }
+            return r;
+        }
         h.fill(0.0);
         for (k, (&i, o)) in self.nodes.iter().zip(&self.offsets).enumerate() {
             let u = rt * (node(x, i) - c) - o;
@@ -186,6 +271,22 @@ impl RigidConstraint {
                 v[3 * k] * y[row] + v[3 * k + 1] * y[row + 1] + v[3 * k + 2] * y[row + 2]
             })
             .sum()
+    }
+
+    /// The moment about `point` of the constraint force `hR_s V λ` at positions `x` (N m; zero
+    /// for the shape constraint, the bearing's moment for an axis lock).
+    pub fn moment(&self, x: &[f64], multipliers: &[f64], point: &Vector3<f64>) -> Vector3<f64> {
+        let r = self.rotation(x);
+        let mut moment = Vector3::zeros();
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let mut local = Vector3::zeros();
+            for (j, &l) in multipliers.iter().enumerate() {
+                let v = &self.column(j)[3 * k..3 * k + 3];
+                local += l * Vector3::new(v[0], v[1], v[2]);
+            }
+            moment += (node(x, i) - point).cross(&(r * local));
+        }
+        moment
     }
 
     /// Adds the constraint force `hR_s V λ` (`λ`: this set's `k` multipliers) to `f` (flat `3N`).

@@ -112,6 +112,22 @@ impl FreeNodes {
         Ok(())
     }
 
+    /// Locks the rotation of the free nodes `nodes` (a rigid set) about every axis but `axis`
+    /// (reference coordinates): a hinge on a rigid set ([`RigidConstraint::axis_lock`]).
+    pub fn add_axis_lock(
+        &mut self,
+        name: &str,
+        nodes: &[usize],
+        reference: &[f64],
+        axis: nalgebra::Vector3<f64>,
+    ) -> Result<()> {
+        let free_rows = self.free_rows(name, nodes)?;
+        self.rigid.push(RigidConstraint::axis_lock(
+            name, nodes, free_rows, reference, axis,
+        )?);
+        Ok(())
+    }
+
     fn free_rows(&self, name: &str, nodes: &[usize]) -> Result<Vec<usize>> {
         nodes
             .iter()

@@ -2,8 +2,8 @@
 
 The FMU (``examples/controlled_arm.json``): Kane's beam (L = 10 m, EI = 1.4e4 N m², rhoA = 1.2 kg/m)
 on a hinge about z at its root face (``bearing``), with a rigid hub of 50 kg and J_hub = 100 kg m²
-about z (a lumped body on the rigid force interface ``hub``, the first element layer next to the
-hinge face) that takes the motor torque ``hub.torque[3]``.
+about z (a lumped body on the rigid force interface ``hub``, on the same face: the hinge holds the
+rigid face's centre and locks it to the axis) that takes the motor torque ``hub.torque[3]``.
 
 The controller is the way Simulink, Dymola or a fmpy loop couple one: every communication step
 H it reads the hub's rotation and angular velocity at the communication point and sets the torque,

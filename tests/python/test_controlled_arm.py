@@ -32,22 +32,21 @@ def test_the_arm_tracks_the_spin_up_at_ten_milliseconds(arm_unzipdir, arm_model_
     print(f"largest tracking error {error.max():.3e} rad; tip deflection peak {deflection.min():.4f} m "
           f"at {t[np.argmin(deflection)]:.2f} s; last 2 s within {np.abs(deflection[t > 18.0]).max():.2e} m")
     # The feedforward J_total alpha_ref carries the spin-up; the PD corrects what the flexible beam
-    # (the hub turns with the beam's root, which bends) and the sampling leave: measured 9.5e-3
-    # rad, against 1.5 rad and more once the loop is unstable (below).
-    assert error.max() < 2e-2
-    # The beam lags in the spin-up as B3's does on its prescribed hub (peak -0.57 m near 7 s; here
-    # the hub turns with the root's first element layer, not the root face: measured -0.515 m at
-    # 6.9 s) and straightens after it (2.5e-5 m in the last 2 s).
-    assert -0.65 < deflection.min() < -0.5
+    # and the sampling leave: measured 1.8e-3 rad, against 1.5 rad and more once the loop is
+    # unstable (below).
+    assert error.max() < 5e-3
+    # The beam lags in the spin-up as B3's does on its prescribed hub (peak -0.571 m near 7 s;
+    # measured -0.569 m) and straightens after it.
+    assert -0.60 < deflection.min() < -0.54
     assert 5.0 < t[np.argmin(deflection)] < 9.0
     assert np.abs(deflection[t > 18.0]).max() < 0.02
 
 
 def test_stable_below_the_hub_bound_and_unstable_above(arm_unzipdir, arm_model_description):
-    # 0.8 x the bound: stable and tracking for the whole spin-up (measured 1.05e-2 rad).
+    # 0.8 x the bound: stable and tracking for the whole spin-up (measured 1.8e-3 rad).
     stable = run(arm_unzipdir, arm_model_description, 0.8 * H_LIMIT, 20.0)
     assert stable["completed"]
-    assert np.abs(stable["angle"] - stable["reference"]).max() < 2e-2
+    assert np.abs(stable["angle"] - stable["reference"]).max() < 5e-3
     # 1.5 x the bound: the loop diverges within 6 s (measured: the hub rate is 2.8 rad/s off the
     # profile at 5.4 s and oscillates by tens of rad/s after; the FMU may refuse a step first).
     unstable = run(arm_unzipdir, arm_model_description, 1.5 * H_LIMIT, 6.0)
