@@ -447,3 +447,38 @@ fn two_pins_on_a_rigid_set_are_refused_by_name() {
         e.message
     );
 }
+
+/// The FMU state carries the rigid sets' and the axis lock's multipliers and the lumped body's
+/// mass points: the controlled arm saved under a torque, serialized into a fresh instance and
+/// stepped on continues bit for bit.
+#[test]
+fn a_saved_state_with_rigid_sets_and_a_lumped_body_continues_bit_for_bit() {
+    let arm = || example_body("controlled_arm");
+    let mut s = initialized(arm(), &[("hub.torque[3]", 50.0)]);
+    let h = 0.01;
+    for k in 0..20 {
+        s.do_step(k as f64 * h, h).unwrap();
+    }
+    let saved = s.get_state();
+    let mut bytes = Vec::new();
+    saved.write_bytes(&mut bytes);
+    let run_on = |s: &mut Slave| -> Vec<f64> {
+        (20..40)
+            .flat_map(|k| {
+                s.do_step(k as f64 * h, h).unwrap();
+                let tip = vector(s, "tip.position");
+                [
+                    tip.x,
+                    tip.y,
+                    get(s, "bearing.force[1]"),
+                    get(s, "bearing.torque[3]"),
+                ]
+            })
+            .collect()
+    };
+    let expected = run_on(&mut s);
+    let mut fresh = initialized(arm(), &[]);
+    let restored = fresh.state_from_bytes(&bytes).unwrap();
+    fresh.set_state(&restored).unwrap();
+    assert_eq!(run_on(&mut fresh), expected);
+}
