@@ -44,13 +44,7 @@ pub(super) fn point_constraints(
     reference: &[f64],
     size: f64,
 ) -> Result<Vec<(Vec<usize>, Vec<f64>)>> {
-    let total: f64 = weights.iter().sum();
-    let centroid = nodes
-        .iter()
-        .zip(weights)
-        .fold(Vector3::zeros(), |c, (&i, w)| {
-            c + *w / total * node(reference, i)
-        });
+    let centroid = weighted_centroid(nodes, weights, reference);
     let tolerance = 1e-9 * size;
     if matches!(spec.kind, InterfaceKind::Pin | InterfaceKind::Hinge) {
         if let Some(p) = spec.reference_point {
@@ -86,7 +80,6 @@ pub(super) fn point_constraints(
                 }
             }
             for (nodes, weights) in &halves {
-                let total: f64 = weights.iter().sum();
                 if nodes.is_empty() {
                     return Err(Error::new(format!(
                         "interface '{}': the node set does not extend along the hinge axis {:?}",
@@ -94,12 +87,7 @@ pub(super) fn point_constraints(
                         axis.as_slice()
                     )));
                 }
-                let c = nodes
-                    .iter()
-                    .zip(weights)
-                    .fold(Vector3::zeros(), |c, (&i, w)| {
-                        c + *w / total * node(reference, i)
-                    });
+                let c = weighted_centroid(nodes, weights, reference);
                 let off_axis = (c - centroid).cross(&axis).norm();
                 if off_axis > 1e-6 * size {
                     return Err(Error::new(format!(
@@ -114,6 +102,17 @@ pub(super) fn point_constraints(
         }
         _ => Ok(Vec::new()),
     }
+}
+
+/// `Σ w_i X_i / Σ w_i` over `nodes` at the reference positions `reference` (m).
+fn weighted_centroid(nodes: &[usize], weights: &[f64], reference: &[f64]) -> Vector3<f64> {
+    let total: f64 = weights.iter().sum();
+    nodes
+        .iter()
+        .zip(weights)
+        .fold(Vector3::zeros(), |c, (&i, w)| {
+            c + *w / total * node(reference, i)
+        })
 }
 
 /// How far from orthonormal a rotation given by the importer may be (`|QᵀQ − I|`, largest
@@ -484,13 +483,7 @@ fn lumped_body_points(
             spec.name
         )));
     }
-    let total: f64 = weights.iter().sum();
-    let centroid = nodes
-        .iter()
-        .zip(weights)
-        .fold(Vector3::zeros(), |c, (&i, w)| {
-            c + *w / total * node(reference, i)
-        });
+    let centroid = weighted_centroid(nodes, weights, reference);
     let point = spec.reference_point.map_or(centroid, Vector3::from);
     let body = crate::body::LumpedBody {
         mass,
