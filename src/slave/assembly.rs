@@ -98,6 +98,9 @@ impl Model {
     }
 }
 
+/// A rigid set of more nodes than this gets a warning about its cost (its `3n − 6` multipliers).
+const LARGE_RIGID_SET: usize = 100;
+
 /// The matrices of the reference mesh: positions `X` (flat `3N`), the scalar mass matrix `Ms`
 /// and the small-strain stiffness `K` (docs/formulation.md, "mass_matrix", "stiffness_matrix").
 struct MeshMatrices {
@@ -413,6 +416,23 @@ impl Slave {
     ) -> Result<()> {
         let started = std::time::Instant::now();
         let free = self.constrained_free_nodes(&body, &clamped)?;
+        for (set, spec) in free.rigid.iter().filter(|r| r.lock.is_none()).zip(
+            self.body_file.interfaces.iter().filter(|s| {
+                s.rigid && !matches!(s.kind, InterfaceKind::Fixed | InterfaceKind::Motion)
+            }),
+        ) {
+            if set.nodes.len() > LARGE_RIGID_SET {
+                self.events.push(LogEvent {
+                    category: category::EVENTS,
+                    message: format!(
+                        "warning: interface '{}': its rigid set has {} nodes, {} Lagrange multipliers: one solve each per step size and a dense product per iteration (docs/formulation.md, \"Rigid attachments\": the connecting rod's small eye made rigid costs 35 s to set up and 3 times the step)",
+                        spec.name,
+                        set.nodes.len(),
+                        set.rows()
+                    ),
+                });
+            }
+        }
         let p = &self.parameters;
         // model.auto's slabs: built now, with the force scratch that serves them, and parked.
         let auto_slabs = p.auto
