@@ -244,6 +244,15 @@ impl Body {
         }
     }
 
+    /// The same body with the elastic force taken with `force_stiffness` instead of
+    /// `stiffness_matrix` (which the iteration matrix and the modal analyses keep): the elements
+    /// wholly inside a rigid set carry no force (docs/formulation.md, "Rigid attachments"), yet
+    /// keep the matrices positive definite, where on the set's rigid motions they add nothing.
+    pub fn with_force_stiffness(mut self, force_stiffness: &SymmetricCsr) -> Body {
+        self.stiffness_product = MatrixProduct::Blocks(BlockCsr3::from_csr(force_stiffness));
+        self
+    }
+
     /// The same body with several co-moving frames (see [`patches`]).
     pub fn with_patches(mut self, patches: Patches) -> Body {
         self.patches = Some(patches);

@@ -107,6 +107,9 @@ struct MeshMatrices {
     reference: Vec<f64>,
     mass_matrix: SymmetricCsr,
     stiffness_matrix: SymmetricCsr,
+    /// `K` without the elements wholly inside rigid sets, for the elastic force (when there are
+    /// such elements).
+    force_stiffness: Option<SymmetricCsr>,
 }
 
 impl Slave {
@@ -132,11 +135,28 @@ impl Slave {
             None => p.material,
         };
         let density = |e: usize| element_material(e).density;
+        // Elements wholly inside a rigid set carry no stiffness: they cannot deform, and with one
+        // co-moving frame their linear strain of the set's rotation against the frame (second
+        // order in it) would stay in them as energy, a spring against that rotation
+        // (docs/formulation.md, "Rigid attachments").
+        let inside = self.elements_inside_rigid_sets();
+        let element_stiffness = |e: usize| IsotropicMaterial {
+            youngs_modulus: if inside[e] {
+                0.0
+            } else {
+                element_material(e).youngs_modulus
+            },
+            ..element_material(e)
+        };
         let mut lumped = fem::lumped_masses_of(&self.mesh, &density);
         let mut matrices = MeshMatrices {
             reference,
             mass_matrix: fem::scalar_mass_matrix_of(&self.mesh, &density),
             stiffness_matrix: fem::stiffness_matrix_of(&self.mesh, &element_material),
+            force_stiffness: inside
+                .iter()
+                .any(|&i| i)
+                .then(|| fem::stiffness_matrix_of(&self.mesh, &element_stiffness)),
         };
         if !self.mass_points.is_empty() {
             self.check_mass_points()?;
@@ -149,9 +169,9 @@ impl Slave {
                     .extend_from_slice(point.position.as_slice());
             }
             matrices.mass_matrix = matrices.mass_matrix.extended(&masses);
-            matrices.stiffness_matrix = matrices
-                .stiffness_matrix
-                .extended(&vec![0.0; 3 * masses.len()]);
+            let none = vec![0.0; 3 * masses.len()];
+            matrices.stiffness_matrix = matrices.stiffness_matrix.extended(&none);
+            matrices.force_stiffness = matrices.force_stiffness.map(|k| k.extended(&none));
             lumped.extend_from_slice(&masses);
         }
         let options = BodyOptions {
@@ -168,6 +188,32 @@ impl Slave {
             )
         };
         self.finish_model(key, body, clamped, &lumped)
+    }
+
+    /// For each element, whether all its nodes belong to one rigid set (of a force interface,
+    /// pin or hinge with `"rigid": true`).
+    fn elements_inside_rigid_sets(&self) -> Vec<bool> {
+        let mut inside = vec![false; self.mesh.element_count()];
+        for (interface, spec) in self.interfaces.iter().zip(&self.body_file.interfaces) {
+            let rigid = spec.rigid
+                && matches!(
+                    interface.kind,
+                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                );
+            if !rigid {
+                continue;
+            }
+            let mut in_set = vec![false; self.mesh.node_count()];
+            for &n in &interface.set.frame_weights.nodes {
+                if n < in_set.len() {
+                    in_set[n] = true;
+                }
+            }
+            for (e, flag) in inside.iter_mut().enumerate() {
+                *flag |= self.mesh.element(e).iter().all(|&n| in_set[n]);
+            }
+        }
+        inside
     }
 
     /// Lumped bodies (mass points) ride on the mesh body with the reduced-strain formulation and
@@ -245,6 +291,7 @@ impl Slave {
         let frame_weights = (0..lumped.len())
             .map(|i| if i < mesh_nodes { lumped[i] } else { 0.0 })
             .collect();
+        let force_stiffness = matrices.force_stiffness;
         let mut body = Body::new(
             matrices.reference,
             matrices.mass_matrix,
@@ -253,13 +300,21 @@ impl Slave {
             options,
         );
         body.lumped_points = self.mass_points.len();
+        if let Some(k) = &force_stiffness {
+            body = body.with_force_stiffness(k);
+        }
         Ok(if p.formulation == Formulation::Full {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
         } else if p.frames > 1 {
             let total = body.node_count();
             body.with_patches(
-                Patches::along_principal_axis(&self.mesh, &p.material, lumped, p.frames as usize)?
-                    .covering(total),
+                Patches::along_principal_axis(
+                    &self.mesh,
+                    &p.material,
+                    &lumped[..mesh_nodes],
+                    p.frames as usize,
+                )?
+                .covering(total),
             )
         } else {
             body
@@ -445,9 +500,11 @@ impl Slave {
             // the beam) 40 slabs for the whole run are within 0.23 % of `full`'s peak, 10 within
             // 0.47 %, one frame 1.57 %, and 40 cost no more than 10 (2.3 s against 2.6 s for
             // 20 s simulated; the slab forces are element-sized products either way).
-            let layers = Patches::element_layers(&self.mesh, lumped);
+            // The mesh's nodes only: a lumped body's mass points would tilt the slabs' axis.
+            let mesh_lumped = &lumped[..self.mesh.node_count()];
+            let layers = Patches::element_layers(&self.mesh, mesh_lumped);
             body.patches = Some(
-                Patches::along_principal_axis(&self.mesh, &p.material, lumped, layers)?
+                Patches::along_principal_axis(&self.mesh, &p.material, mesh_lumped, layers)?
                     .covering(body.node_count()),
             );
         }

@@ -370,9 +370,15 @@ pub(super) fn interfaces_of(
         let mut weights: Vec<f64> = nodes.iter().map(|&i| lumped[i]).collect();
         let point_constraints = point_constraints(spec, &nodes, &weights, &reference, size)?;
         whole_sets.push((nodes.clone(), weights.clone()));
+        // The reference point defaults to the weighted centroid of the mesh nodes (before a
+        // lumped body's mass points join the set).
+        let reference_point = spec.reference_point.map_or_else(
+            || weighted_centroid(&nodes, &weights, &reference),
+            Vector3::from,
+        );
         // A lumped body joins the set as six mass points (docs/formulation.md, "Rigid
         // attachments"), weighted like an average node of the set.
-        for (position, mass) in lumped_body_points(spec, &nodes, &weights, &reference)? {
+        for (position, mass) in lumped_body_points(spec, reference_point)? {
             let index = reference.len() / 3;
             reference.extend_from_slice(position.as_slice());
             weights.push(weights.iter().sum::<f64>() / weights.len() as f64);
@@ -390,7 +396,7 @@ pub(super) fn interfaces_of(
             nodes,
             weights,
             &reference,
-            spec.reference_point.map(Vector3::from),
+            Some(reference_point),
         )?;
         interfaces.push(Interface {
             kind: spec.kind,
@@ -457,15 +463,13 @@ pub(super) struct MassPoint {
     pub(super) mass: f64,
 }
 
-/// The mass points of `spec`'s lumped body (none without `mass`). Its reference point is the
-/// interface's (the weighted centroid of `nodes` if not given). Error if the interface cannot
-/// carry one: a lumped body needs a rigid set (`"rigid": true`, or a fixed support or motion
-/// interface, which are rigid anyway).
+/// The mass points of `spec`'s lumped body (none without `mass`), its inertia about the
+/// interface's `reference_point` (without `inertia`: a point mass, `I_c = 0`). Error if the
+/// interface cannot carry one: a lumped body needs a rigid set (`"rigid": true`, or a fixed
+/// support or motion interface, which are rigid anyway).
 fn lumped_body_points(
     spec: &crate::model::InterfaceSpec,
-    nodes: &[usize],
-    weights: &[f64],
-    reference: &[f64],
+    point: Vector3<f64>,
 ) -> Result<Vec<(Vector3<f64>, f64)>> {
     let Some(mass) = spec.mass else {
         if spec.inertia.is_some() || spec.center_of_mass.is_some() {
@@ -483,14 +487,15 @@ fn lumped_body_points(
             spec.name
         )));
     }
-    let centroid = weighted_centroid(nodes, weights, reference);
-    let point = spec.reference_point.map_or(centroid, Vector3::from);
+    let center_of_mass = spec.center_of_mass.map_or(point, Vector3::from);
+    let d = center_of_mass - point;
     let body = crate::body::LumpedBody {
         mass,
-        center_of_mass: spec.center_of_mass.map_or(point, Vector3::from),
-        inertia: spec
-            .inertia
-            .map_or(Matrix3::zeros(), |rows| Matrix3::from_fn(|i, j| rows[i][j])),
+        center_of_mass,
+        inertia: spec.inertia.map_or(
+            mass * (Matrix3::identity() * d.norm_squared() - d * d.transpose()),
+            |rows| Matrix3::from_fn(|i, j| rows[i][j]),
+        ),
         point,
     };
     body.mass_points(&spec.name)

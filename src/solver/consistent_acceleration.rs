@@ -22,7 +22,7 @@ use super::problem::FreeNodes;
 use crate::body::frame::node;
 use crate::error::{Error, Result};
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
-use nalgebra::{DMatrix, DVector, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
 /// The factor of `Ms_FF` and the constraint projection.
 pub struct ConsistentAcceleration {
@@ -169,9 +169,9 @@ impl ConsistentAcceleration {
                 columns.push(w);
             }
         }
+        let rotations: Vec<Matrix3<f64>> = free.rigid.iter().map(|set| set.rotation(x)).collect();
         let mut rigid = self.rigid_columns.iter();
-        for set in &free.rigid {
-            let r = set.rotation(x);
+        for (set, r) in free.rigid.iter().zip(&rotations) {
             for _ in 0..set.rows() {
                 let w = rigid.next().expect("one column per multiplier");
                 let mut rotated = vec![0.0; 3 * nf];
@@ -194,9 +194,9 @@ impl ConsistentAcceleration {
                     .sum()
             } else {
                 let mut row = points;
-                for set in &free.rigid {
+                for (set, r) in free.rigid.iter().zip(&rotations) {
                     if i < row + set.rows() {
-                        let rt = set.rotation(x).transpose();
+                        let rt = r.transpose();
                         let v = set.column(i - row);
                         return set
                             .free_rows

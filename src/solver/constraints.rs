@@ -315,6 +315,8 @@ pub struct ConstraintFactor {
     /// Scratch: `hR_cᵀ e` and `μ` (3m each).
     pub error: Vec<f64>,
     pub mu: Vec<f64>,
+    /// Scratch: a rigid set's part of `y` turned into the set's frame (`3n` of the largest set).
+    set_part: Vec<f64>,
 }
 
 impl ConstraintFactor {
@@ -382,6 +384,7 @@ impl ConstraintFactor {
             schur_inverse,
             error: vec![0.0; m],
             mu: vec![0.0; m],
+            set_part: vec![0.0; 3 * rigid.iter().map(|r| r.nodes.len()).max().unwrap_or(0)],
         })
     }
 
@@ -416,10 +419,17 @@ impl ConstraintFactor {
         }
         let mut row = 3 * constraints.len();
         for set in rigid {
+            // The linearised error h(x) − Vᵀ hR_sᵀ hR y: y turned from the body's frame into the
+            // set's (the matrix's Ā takes the two as one; the error does not need to).
             let k = set.rows();
-            set.violation(x, &mut self.error[row..row + k]);
+            let q = set.violation(x, &mut self.error[row..row + k]).transpose() * r;
+            let part = &mut self.set_part[..3 * set.nodes.len()];
+            for (local, &fr) in set.free_rows.iter().enumerate() {
+                let turned = q * Vector3::new(reduced[fr], reduced[fr + 1], reduced[fr + 2]);
+                part[3 * local..3 * local + 3].copy_from_slice(turned.as_slice());
+            }
             for j in 0..k {
-                self.error[row + j] -= set.free_dot(j, reduced);
+                self.error[row + j] -= crate::linalg::dot(set.column(j), part);
             }
             row += k;
         }

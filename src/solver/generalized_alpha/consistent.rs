@@ -44,8 +44,9 @@ pub fn initial_acceleration(
 /// loads' acceleration (the left limit) and a jump costs an error of order `h`, which made the
 /// scheme first order under inputs that change (`tests/convergence_order.rs`). For a linear
 /// system this is exact superposition: the jump's response is a fresh start from rest with
-/// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation (`forces`
-/// and `ws` serve as scratch).
+/// the consistent acceleration `M⁻¹ Δf` (initialization's `a_0 = ẍ_0`). No allocation without
+/// rigid sets (`forces` and `ws` serve as scratch; with them the projection allocates, see
+/// [`ConsistentAcceleration`]).
 ///
 /// The slave does not call it: restarting at every jump of held inputs destabilised the
 /// iterated coupling of two FMUs (see `Slave::do_step`); it is kept for importers' schemes that
