@@ -89,6 +89,10 @@ pub struct Body {
     /// The last `lumped_points` nodes are the mass points of lumped bodies (no stiffness, no
     /// weight in the co-moving frame; docs/formulation.md, "Rigid attachments").
     pub lumped_points: usize,
+    /// With rigid sets: `K` with the elements wholly inside them, for the modal analyses (the
+    /// lowest period, `model.auto`'s modes), which do not see the sets' constraints;
+    /// `stiffness_matrix` leaves those elements out (docs/formulation.md, "Rigid attachments").
+    pub modal_stiffness: Option<SymmetricCsr>,
 }
 
 /// How a constant `3N × 3N` matrix is stored for the products of the hot path.
@@ -184,6 +188,7 @@ impl Body {
             reduction: None,
             nonlinear_forces_switchable: false,
             lumped_points: 0,
+            modal_stiffness: None,
         }
     }
 
@@ -213,6 +218,7 @@ impl Body {
             reduction: Some(Box::new(reduction)),
             nonlinear_forces_switchable: false,
             lumped_points: 0,
+            modal_stiffness: None,
         }
     }
 
@@ -242,15 +248,6 @@ impl Body {
             set_node(x, i, &(e * origin + r));
             set_node(v, i, &(e * velocity + angular_velocity.cross(&r)));
         }
-    }
-
-    /// The same body with the elastic force taken with `force_stiffness` instead of
-    /// `stiffness_matrix` (which the iteration matrix and the modal analyses keep): the elements
-    /// wholly inside a rigid set carry no force (docs/formulation.md, "Rigid attachments"), yet
-    /// keep the matrices positive definite, where on the set's rigid motions they add nothing.
-    pub fn with_force_stiffness(mut self, force_stiffness: &SymmetricCsr) -> Body {
-        self.stiffness_product = MatrixProduct::Blocks(BlockCsr3::from_csr(force_stiffness));
-        self
     }
 
     /// The same body with several co-moving frames (see [`patches`]).

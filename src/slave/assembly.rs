@@ -107,8 +107,8 @@ struct MeshMatrices {
     reference: Vec<f64>,
     mass_matrix: SymmetricCsr,
     stiffness_matrix: SymmetricCsr,
-    /// `K` without the elements wholly inside rigid sets, for the elastic force (when there are
-    /// such elements).
+    /// `K` without the elements wholly inside rigid sets (when there are such elements): the
+    /// body's `K`, the elastic force's and the iteration matrix's.
     force_stiffness: Option<SymmetricCsr>,
 }
 
@@ -291,18 +291,22 @@ impl Slave {
         let frame_weights = (0..lumped.len())
             .map(|i| if i < mesh_nodes { lumped[i] } else { 0.0 })
             .collect();
-        let force_stiffness = matrices.force_stiffness;
+        // With rigid sets, the body's K leaves out the elements inside them; the modal analyses
+        // keep them (they do not see the sets' constraints).
+        let (stiffness, modal_stiffness) = match matrices.force_stiffness {
+            Some(k) => (k, Some(matrices.stiffness_matrix)),
+            None => (matrices.stiffness_matrix, None),
+        };
         let mut body = Body::new(
             matrices.reference,
             matrices.mass_matrix,
-            matrices.stiffness_matrix,
+            stiffness,
             frame_weights,
             options,
         );
         body.lumped_points = self.mass_points.len();
-        if let Some(k) = &force_stiffness {
-            body = body.with_force_stiffness(k);
-        }
+        body.modal_stiffness = modal_stiffness;
+
         Ok(if p.formulation == Formulation::Full {
             body.with_full_formulation(SvkSolid::new(&self.mesh, &p.material))
         } else if p.frames > 1 {

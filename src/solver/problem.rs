@@ -43,6 +43,8 @@ pub struct FreeNodes {
     /// The first `elastic_nodes` free nodes are the mesh's; the others are lumped bodies' mass
     /// points (no stiffness).
     pub elastic_nodes: usize,
+    /// `Body::modal_stiffness` restricted to the free DOFs, if the body has one.
+    modal_stiffness: Option<SymmetricCsr>,
 }
 
 impl FreeNodes {
@@ -54,6 +56,7 @@ impl FreeNodes {
         let dofs = node_dofs(&nodes);
         let mass = body.mass_matrix.kron_i3().submatrix(&dofs);
         let stiffness = body.stiffness_matrix.submatrix(&dofs);
+        let modal_stiffness = body.modal_stiffness.as_ref().map(|k| k.submatrix(&dofs));
         let scalar_mass = body.mass_matrix.submatrix(&nodes);
         FreeNodes {
             nodes,
@@ -64,18 +67,21 @@ impl FreeNodes {
             constraints: Vec::new(),
             rigid: Vec::new(),
             elastic_nodes,
+            modal_stiffness,
         }
     }
 
     /// `K` and `M ⊗ I3` on the free mesh nodes' DOFs (without the lumped bodies' mass points,
-    /// whose zero stiffness would add zero frequencies): what a modal analysis of the elastic
+    /// whose zero stiffness would add zero frequencies, and with the elements inside rigid sets,
+    /// whose constraints a modal analysis does not see): what a modal analysis of the elastic
     /// body takes.
     pub fn elastic_matrices(&self) -> (SymmetricCsr, SymmetricCsr) {
+        let stiffness = self.modal_stiffness.as_ref().unwrap_or(&self.stiffness);
         let dofs: Vec<usize> = (0..3 * self.elastic_nodes).collect();
-        if dofs.len() == self.stiffness.n {
-            return (self.stiffness.clone(), self.mass.clone());
+        if dofs.len() == stiffness.n {
+            return (stiffness.clone(), self.mass.clone());
         }
-        (self.stiffness.submatrix(&dofs), self.mass.submatrix(&dofs))
+        (stiffness.submatrix(&dofs), self.mass.submatrix(&dofs))
     }
 
     /// The global DOFs of the free nodes, in the order of the reduced system.
