@@ -157,3 +157,55 @@ fn the_sample_times_are_part_of_the_fmu_state() {
     fresh.do_step(0.51, big_h).unwrap();
     assert_eq!(drive.tip_deflection(&mut fresh, 0.52).unwrap(), expected);
 }
+
+/// The same B3 under the error control (`model.accuracy = 1e-3`) with two half steps per input
+/// update: at 1.67 s `model.auto` switches on its slabs and the control refines, after which the
+/// estimates on the fine rungs no longer fall with the step (docs/formulation.md, "Probes").
+/// Without probes the internal step stayed on 0.16 ms for the rest of the run, 16 times the work
+/// of whole steps; with them the body climbs back up, each climb logged. The whole steps take
+/// one 10 ms internal step per update (nothing to estimate after an input jump), so the curves
+/// differ by the time integration error of 10 ms steps: 2.0e-3 of B3's 0.57 m peak over the 20 s
+/// (the full formulation at 10 ms against 2.5 ms, docs/formulation.md "Probes"); the first 3 s
+/// are compared against that bound.
+#[test]
+fn an_importer_that_splits_steps_does_not_trap_the_error_control_on_a_fine_rung() {
+    let settings = [("model.accuracy", 1e-3)];
+    let mut whole = initialized(example_body("hub_beam"), &settings);
+    let mut split = initialized(example_body("hub_beam"), &settings);
+    let drive = HubDrive::new(&whole);
+    let big_h = 1e-2;
+    let (mut worst, mut finest, mut climbs) = (0.0_f64, f64::INFINITY, Vec::new());
+    for k in 0..300 {
+        let t = k as f64 * big_h;
+        let y_whole = drive.step(&mut whole, t, big_h).unwrap();
+        drive.set_hub(&mut split, t).unwrap();
+        split.do_step(t, 0.5 * big_h).unwrap();
+        split.do_step(t + 0.5 * big_h, 0.5 * big_h).unwrap();
+        let y_split = drive.tip_deflection(&mut split, t + big_h).unwrap();
+        worst = worst.max((y_split - y_whole).abs());
+        finest = finest.min(split.controlled_step_size());
+        let rung = split.controlled_step_size();
+        if split
+            .drain_events()
+            .any(|e| e.message.contains("(a probe)"))
+        {
+            climbs.push((t, rung));
+        }
+    }
+    let end = split.controlled_step_size();
+    println!(
+        "finest rung {finest:e} s, at 3 s {end:e} s; probes that climbed: {climbs:?}; internal steps split {}, whole {}; largest difference {worst:.3e} m",
+        split.solver_statistics().0,
+        whole.solver_statistics().0
+    );
+    assert!(
+        finest < 1e-3,
+        "the slabs' switch refines: finest rung {finest}"
+    );
+    assert!(!climbs.is_empty(), "no probe climbed back up");
+    assert!(end >= 2.0 * finest, "the step stayed on the finest rung");
+    assert!(
+        worst < 2.0e-3 * 0.571,
+        "split steps leave the whole-step curve by {worst:e} m"
+    );
+}

@@ -4,6 +4,7 @@
 use super::assembly::Features;
 use super::auto_features::NOT_QUIET;
 use super::interfaces::{apply_loads, prescribe_motion, rotation_input};
+use super::step_control::Ladder;
 use super::{Dynamics, Slave};
 use crate::error::{Error, Result};
 use crate::model::InterfaceKind;
@@ -113,7 +114,7 @@ impl Slave {
             gravity: self.parameters.gravity,
             features,
             quiet_since: [NOT_QUIET; 2],
-            step_level: 0,
+            ladder: Ladder::default(),
             deformation_scale: 0.0,
         });
         self.outputs.valid = false;

@@ -20,6 +20,7 @@ use nalgebra::Vector3;
 use outputs::Outputs;
 use results::file_stem;
 use std::path::Path;
+use step_control::Ladder;
 use variables::component_of;
 
 mod assembly;
@@ -74,8 +75,8 @@ struct Dynamics {
     /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
     quiet_since: [f64; 2],
     /// The rung `k` of the internal step `solver.stepSize / 2^k` for the next communication
-    /// step ([`step_control`]).
-    step_level: u32,
+    /// step, and when the rung above is next probed ([`step_control`]).
+    ladder: Ladder,
     /// The deformation scale `D` (m): the largest mass-weighted RMS elastic displacement seen so
     /// far ([`step_control`]).
     deformation_scale: f64,
@@ -417,7 +418,7 @@ impl Slave {
     /// The internal step the error control has chosen for the next communication step (s): the
     /// rung `solver.stepSize / 2^k` (before the communication step divides it evenly).
     pub fn controlled_step_size(&self) -> f64 {
-        let level = self.dynamics.as_ref().map_or(0, |d| d.step_level);
+        let level = self.dynamics.as_ref().map_or(0, |d| d.ladder.level);
         step_control::rung(self.parameters.step_size, level)
     }
 
@@ -512,7 +513,7 @@ impl Slave {
                 d.gravity = s.gravity;
                 d.features = s.features;
                 d.quiet_since = s.quiet_since;
-                d.step_level = s.step_level;
+                d.ladder = s.ladder;
                 d.deformation_scale = s.deformation_scale;
             }
             (d, s) => *d = s.clone(),

@@ -15,7 +15,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level u32; deformation scale f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; deformation scale f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -29,7 +29,7 @@ use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 6;
+pub const PAYLOAD_FORMAT: u32 = 7;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -206,7 +206,9 @@ impl SlaveState {
                     | u8::from(d.features.frames) << 2
                     | u8::from(d.features.frames_refused) << 3);
                 w.f64s(&d.quiet_since);
-                w.u32(d.step_level);
+                w.u32(d.ladder.level);
+                w.u32(d.ladder.calm_steps);
+                w.u32(d.ladder.probe_after);
                 w.f64(d.deformation_scale);
                 w.f64(s.step_size);
             }
@@ -388,6 +390,15 @@ impl Slave {
                         super::step_control::MAX_LEVEL
                     )));
                 }
+                let calm_steps = r.u32("the calm steps on the step level")?;
+                let probe_after = r.u32("the steps the next probe of the step level waits for")?;
+                let probe_range =
+                    super::step_control::PROBE_FIRST..=super::step_control::PROBE_LAST;
+                if !probe_range.contains(&probe_after) {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state holds {probe_after} for the steps the next probe waits for: not within {probe_range:?}"
+                    )));
+                }
                 let deformation_scale = r.f64("the deformation scale")?;
                 if deformation_scale < 0.0 {
                     return Err(Error::new(format!(
@@ -415,7 +426,11 @@ impl Slave {
                     gravity,
                     features,
                     quiet_since,
-                    step_level,
+                    ladder: super::step_control::Ladder {
+                        level: step_level,
+                        calm_steps,
+                        probe_after,
+                    },
                     deformation_scale,
                 })
             }

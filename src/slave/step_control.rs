@@ -22,6 +22,18 @@
 //! its start on a finer rung (the local error is third order in `h` and the allowance first
 //! order: the ratio falls like `h²`); one that stayed below [`GROW_BELOW`] moves one rung up for
 //! the next. Steps on a rung seen before reuse its factorization (`MATRIX_CACHE_SIZE`).
+//!
+//! A rung reached by refining can hold an estimate that does not fall with the step: the
+//! iteration's noise (a step accepted on the contraction estimate of its first two corrections
+//! carries more than `solver.tolerance × size`) or a ringing the steps do not resolve, both about
+//! the same whatever `h` is, while the allowance falls like `h`. Waiting for the ratio to fall
+//! below [`GROW_BELOW`] would then keep the fine rung for the rest of the run (B3 at
+//! `model.accuracy` 1e-3, stepped as two half steps per input update: 22 internal steps per half
+//! step from 1.67 s on, 16 times the work of whole steps). So after [`PROBE_FIRST`] communication
+//! steps in a row below [`PROBE_BELOW`] on a rung, the next one is taken on the rung above (a
+//! probe): if it stays within its allowance the body keeps the coarser rung, if not it is redone
+//! on its own rung and the next probe waits twice as long (at most [`PROBE_LAST`] steps), which
+//! bounds the cost of probes that fail to a few per cent of the steps.
 
 /// The floor of the allowance in units of the iteration's tolerance `solver.tolerance × size`:
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
@@ -36,6 +48,81 @@ pub const GROW_BELOW: f64 = 0.125;
 
 /// The order of `e / allowance` in `h` (local error `h³` against an allowance `∝ h`).
 pub const RATIO_ORDER: f64 = 2.0;
+
+/// Communication steps on a rung, each with its largest ratio below [`PROBE_BELOW`], before
+/// the next is taken as a probe on the rung above (see the module documentation).
+pub const PROBE_FIRST: u32 = 8;
+
+/// The longest wait between probes (communication steps), reached by doubling [`PROBE_FIRST`]
+/// after each probe that failed.
+pub const PROBE_LAST: u32 = 256;
+
+/// A communication step counts towards a probe when its largest ratio is below this: on the rung
+/// above, a ratio that falls like `h²` would be below 2 (a failed probe costs one step on the
+/// coarser rung), one that does not fall with `h` below 1/2.
+pub const PROBE_BELOW: f64 = 0.5;
+
+/// Where the internal step stands on the ladder between communication steps (part of the FMU
+/// state).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ladder {
+    /// The rung `k` of the next communication step's internal steps, `solver.stepSize / 2^k`.
+    pub level: u32,
+    /// Communication steps in a row on this rung below [`PROBE_BELOW`].
+    pub calm_steps: u32,
+    /// How many such steps the next probe waits for ([`PROBE_FIRST`] … [`PROBE_LAST`]).
+    pub probe_after: u32,
+}
+
+impl Default for Ladder {
+    fn default() -> Ladder {
+        Ladder {
+            level: 0,
+            calm_steps: 0,
+            probe_after: PROBE_FIRST,
+        }
+    }
+}
+
+impl Ladder {
+    /// Whether the next communication step is a probe on the rung above.
+    pub fn probes(&self) -> bool {
+        self.level > 0 && self.calm_steps >= self.probe_after
+    }
+
+    /// On rung `level`, with the memory of a probe cleared (the rung changed).
+    pub fn on(level: u32) -> Ladder {
+        Ladder {
+            level,
+            ..Ladder::default()
+        }
+    }
+
+    /// After a communication step on this rung whose largest ratio was `ratio` (`None`: no
+    /// step was estimated).
+    pub fn after_step(self, ratio: Option<f64>) -> Ladder {
+        match ratio {
+            Some(r) if r < PROBE_BELOW => Ladder {
+                calm_steps: self.calm_steps.saturating_add(1),
+                ..self
+            },
+            Some(_) => Ladder {
+                calm_steps: 0,
+                ..self
+            },
+            None => self,
+        }
+    }
+
+    /// After a probe from this rung that failed: the same rung, the next probe twice as far off.
+    pub fn after_failed_probe(self) -> Ladder {
+        Ladder {
+            calm_steps: 0,
+            probe_after: (2 * self.probe_after).min(PROBE_LAST),
+            ..self
+        }
+    }
+}
 
 /// The internal step of rung `level`: `step_size / 2^level` (s).
 pub fn rung(step_size: f64, level: u32) -> f64 {
@@ -69,6 +156,32 @@ mod tests {
             }
         }
         assert_eq!(finer_level(MAX_LEVEL - 1, 100.0), MAX_LEVEL);
+    }
+
+    #[test]
+    fn a_probe_comes_after_calm_steps_and_waits_longer_after_each_failure() {
+        let mut ladder = Ladder::on(3);
+        for _ in 0..PROBE_FIRST {
+            assert!(!ladder.probes());
+            ladder = ladder.after_step(Some(0.3));
+        }
+        assert!(ladder.probes());
+        // A ratio at or above PROBE_BELOW starts the count again; no estimate leaves it.
+        assert!(!ladder.after_step(Some(PROBE_BELOW)).probes());
+        assert!(ladder.after_step(None).probes());
+        let mut waits = Vec::new();
+        for _ in 0..8 {
+            ladder = ladder.after_failed_probe();
+            waits.push(ladder.probe_after);
+        }
+        assert_eq!(waits, [16, 32, 64, 128, 256, 256, 256, 256]);
+        assert_eq!(ladder.level, 3);
+        // The top rung has nothing above it.
+        let mut top = Ladder::on(0);
+        for _ in 0..2 * PROBE_LAST {
+            top = top.after_step(Some(0.0));
+        }
+        assert!(!top.probes());
     }
 
     #[test]

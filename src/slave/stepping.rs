@@ -2,7 +2,9 @@
 
 use super::auto_features::choose_features;
 use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
-use super::step_control::{allowance, finer_level, rung, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL};
+use super::step_control::{
+    allowance, finer_level, rung, Ladder, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL,
+};
 use super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
@@ -35,7 +37,10 @@ impl Slave {
         // give the same bits in every importer.
         let t0 = self.time();
         let controlled = self.error_controlled();
-        let mut level = self.dynamics.as_ref().unwrap().step_level;
+        let ladder = self.dynamics.as_ref().unwrap().ladder;
+        // A probe takes this step on the rung above (step_control, "probes").
+        let mut probing = controlled && ladder.probes();
+        let mut level = ladder.level - u32::from(probing);
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
         self.inputs_jumped = self.update_driving_frames()?;
         // Held inputs that jump at a communication point are not restarted from consistent
@@ -43,6 +48,7 @@ impl Slave {
         // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
         // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
         // H = 2e-4 s). Input derivatives give continuous loads instead.
+        let mut failed_probe = false;
         let result = loop {
             let (n, h) = self.internal_steps(big_h, level)?;
             self.prepare_step(h)?;
@@ -85,19 +91,35 @@ impl Slave {
             let ratio = self.step_error.unwrap_or(0.0);
             if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
-                // control").
-                let finer = finer_level(level, ratio);
+                // control"); a probe on the rung it came from.
+                let finer = if probing {
+                    ladder.level
+                } else {
+                    finer_level(level, ratio)
+                };
                 self.rejected += 1;
                 self.events.push(LogEvent {
                     category: category::EVENTS,
                     message: format!(
-                        "model.accuracy: the step from t = {t0} by {big_h} estimated {ratio:.2} × its allowed error with internal steps of {h:e} s; redone with internal steps of at most {:e} s",
-                        rung(self.parameters.step_size, finer)
+                        "model.accuracy: the step from t = {t0} by {big_h} estimated {ratio:.2} × its allowed error with internal steps of {h:e} s; redone with internal steps of at most {:e} s{}",
+                        rung(self.parameters.step_size, finer),
+                        if probing {
+                            format!(
+                                " (a probe of the rung above failed; the next waits for {} steps)",
+                                ladder.after_failed_probe().probe_after
+                            )
+                        } else {
+                            String::new()
+                        }
                     ),
                 });
                 let backup = self.backup.as_ref().unwrap();
                 self.dynamics.as_mut().unwrap().state.copy_from(backup);
                 level = finer;
+                if probing {
+                    probing = false;
+                    failed_probe = true;
+                }
                 continue;
             }
             break result;
@@ -113,19 +135,30 @@ impl Slave {
         match result {
             Ok(()) => {
                 let quiet = self.step_error.is_some_and(|r| r < GROW_BELOW);
-                if controlled && quiet && level > 0 {
-                    level -= 1;
+                let next = if controlled && quiet && level > 0 {
+                    level - 1
+                } else {
+                    level
+                };
+                if next != ladder.level && (probing || next < level) {
                     self.events.push(LogEvent {
                         category: category::EVENTS,
                         message: format!(
-                            "model.accuracy: at t = {} the estimated error was {:.3} of its allowance; the next internal steps are at most {:e} s",
+                            "model.accuracy: at t = {} the estimated error was {:.3} of its allowance{}; the next internal steps are at most {:e} s",
                             t0 + big_h,
                             self.step_error.unwrap_or(0.0),
-                            rung(self.parameters.step_size, level)
+                            if probing { " on the rung above (a probe)" } else { "" },
+                            rung(self.parameters.step_size, next)
                         ),
                     });
                 }
-                dynamics.step_level = level;
+                dynamics.ladder = if next != ladder.level {
+                    Ladder::on(next)
+                } else if failed_probe {
+                    ladder.after_failed_probe()
+                } else {
+                    ladder.after_step(self.step_error)
+                };
                 self.finish_step(t0, big_h);
                 Ok(())
             }
