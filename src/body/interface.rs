@@ -298,6 +298,25 @@ impl DrivingFrame {
 }
 
 impl NodeSet {
+    /// Calls `each(index, offset, point)` for every coordinate the set holds: a mesh node
+    /// (`point`, offset `X_i − X_ref` from the reference point) or, on a reduced body, a held
+    /// coordinate ([`HeldCoordinate`]). Driven by a frame `(p, Q)` the coordinate is `p + Q d`
+    /// (`point`) or `Q d`, `d` the offset.
+    pub fn for_each_held(
+        &self,
+        reference: &[f64],
+        mut each: impl FnMut(usize, Vector3<f64>, bool),
+    ) {
+        match &self.expansion {
+            Some(e) => e.held.iter().for_each(|h| each(h.index, h.offset, h.point)),
+            None => {
+                for &n in &self.frame_weights.nodes {
+                    each(n, node(reference, n) - self.reference_point, true);
+                }
+            }
+        }
+    }
+
     /// Clamps the nodes to `frame` at `τ`: `x_i = p(τ) + Q(τ)(X_i − X_ref)`,
     /// `ẋ_i = v + ω × (x_i − p)`, `ẍ_i = ω × (ω × (x_i − p))` (X_ref: the reference point).
     pub fn prescribe(
@@ -311,27 +330,17 @@ impl NodeSet {
     ) {
         let (p, q) = frame.at(tau);
         let w = frame.angular_velocity;
-        if let Some(e) = &self.expansion {
-            // q_k = p + Q d (a point) or Q d (a direction), see `HeldCoordinate`.
-            for h in &e.held {
-                let r = q * h.offset;
-                let (x0, v0) = if h.point {
-                    (p, frame.velocity)
-                } else {
-                    (Vector3::zeros(), Vector3::zeros())
-                };
-                set_node(x, h.index, &(x0 + r));
-                set_node(v, h.index, &(v0 + w.cross(&r)));
-                set_node(a, h.index, &w.cross(&w.cross(&r)));
-            }
-            return;
-        }
-        for &n in &self.frame_weights.nodes {
-            let r = q * (node(reference, n) - self.reference_point);
-            set_node(x, n, &(p + r));
-            set_node(v, n, &(frame.velocity + w.cross(&r)));
-            set_node(a, n, &w.cross(&w.cross(&r)));
-        }
+        self.for_each_held(reference, |index, offset, point| {
+            let r = q * offset;
+            let (x0, v0) = if point {
+                (p, frame.velocity)
+            } else {
+                (Vector3::zeros(), Vector3::zeros())
+            };
+            set_node(x, index, &(x0 + r));
+            set_node(v, index, &(v0 + w.cross(&r)));
+            set_node(a, index, &w.cross(&w.cross(&r)));
+        });
     }
 }
 

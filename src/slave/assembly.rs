@@ -70,6 +70,8 @@ pub(super) struct Model {
     /// control lets the errors add up to `model.accuracy` (`slave::step_control`). `None`
     /// without error control.
     pub(super) first_period: Option<f64>,
+    /// The step Jacobian's vectors, allocated on its first use (`Slave::step_jacobian`).
+    pub(super) jacobian: Option<super::step_jacobian::JacobianWorkspace>,
 }
 
 impl Model {
@@ -589,6 +591,7 @@ impl Slave {
             parked_geometric_stiffness: None,
             parked_patches,
             first_period,
+            jacobian: None,
         });
         self.dynamics = None;
         // The backups have the old model's size (a changed model.modes changes it).

@@ -145,7 +145,7 @@ impl Slave {
             }
             None => RigidPlacement {
                 origin: Vector3::from(p.initial_position),
-                rotation: rotation_input("initial.rotation", &p.initial_rotation)?,
+                rotation: rotation_input("initial.rotation", "", &p.initial_rotation)?,
                 anchor: Vector3::zeros(),
                 velocity: Vector3::from(p.initial_velocity),
                 angular_velocity: Vector3::from(p.initial_angular_velocity),

@@ -122,13 +122,14 @@ pub(super) const ROTATION_TOLERANCE: f64 = 1e-3;
 
 /// The rotation `name` = `values` (row-major): the nearest rotation of a matrix within
 /// [`ROTATION_TOLERANCE`] of orthonormal with a positive determinant, otherwise an error naming
-/// the variable and the values.
-pub(super) fn rotation_input(name: &str, values: &[f64]) -> Result<Matrix3<f64>> {
+/// the variable (`name`, followed by `suffix`) and the values. (The name comes in two parts so
+/// that a motion interface's rotation, checked on every step, is named without allocating.)
+pub(super) fn rotation_input(name: &str, suffix: &str, values: &[f64]) -> Result<Matrix3<f64>> {
     let q = Matrix3::from_row_slice(values);
     let deviation = (q.transpose() * q - Matrix3::identity()).amax();
     if deviation > ROTATION_TOLERANCE || q.determinant() <= 0.0 {
         return Err(Error::new(format!(
-            "{name} = {values:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); values within {ROTATION_TOLERANCE:e} of orthonormal are orthonormalised",
+            "{name}{suffix} = {values:?} rejected: not a rotation matrix (|QᵀQ − I| = {deviation:.2e}, det = {:.6}); values within {ROTATION_TOLERANCE:e} of orthonormal are orthonormalised",
             q.determinant()
         )));
     }
@@ -143,7 +144,7 @@ pub(super) fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame>
     let r = slot(InterfaceQuantity::Rotation);
     Ok(DrivingFrame {
         position: vector(InterfaceQuantity::Position),
-        rotation: rotation_input(&format!("{name}.rotation"), &values[r..r + 9])?,
+        rotation: rotation_input(name, ".rotation", &values[r..r + 9])?,
         velocity: vector(InterfaceQuantity::Velocity),
         angular_velocity: vector(InterfaceQuantity::AngularVelocity),
     })

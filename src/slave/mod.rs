@@ -33,6 +33,7 @@ mod parameters;
 mod results;
 mod state_bytes;
 mod step_control;
+mod step_jacobian;
 mod stepping;
 mod variables;
 pub use crate::solver::integrator::MATRIX_CACHE_SIZE;
@@ -141,6 +142,9 @@ pub struct Slave {
     /// The communication step last taken (0 before the first): a step within ulps of it is
     /// taken as it (see `snapped_step`).
     last_step_size: f64,
+    /// The internal steps (count, length) of the last `fmi2DoStep`, for its step Jacobian
+    /// (`None` before the first step and after a reset, an FMU state set or a failed step).
+    jacobian_step: Option<(usize, f64)>,
     /// The driving frames of motion interfaces at the start of the current step.
     driving: Vec<DrivingFrame>,
     start_time: f64,
@@ -242,6 +246,7 @@ impl Slave {
             input_times: vec![0.0; n_interfaces],
             input_ages: vec![0.0; n_interfaces],
             last_step_size: 0.0,
+            jacobian_step: None,
             driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
@@ -322,6 +327,7 @@ impl Slave {
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
         self.dynamics = None;
         self.last_step_size = 0.0;
+        self.jacobian_step = None;
         self.input_times.fill(self.start_time);
         self.outputs.valid = false;
         Ok(())
@@ -450,6 +456,7 @@ impl Slave {
         self.start_time = 0.0;
         self.input_times.fill(0.0);
         self.last_step_size = 0.0;
+        self.jacobian_step = None;
         self.dynamics = None;
         self.backup = None;
         self.statistics = (0, 0);
@@ -491,6 +498,7 @@ impl Slave {
         self.input_derivatives.clone_from(&state.input_derivatives);
         self.input_times.clone_from(&state.input_times);
         self.last_step_size = state.last_step_size;
+        self.jacobian_step = None;
         self.start_time = state.start_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];

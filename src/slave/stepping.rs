@@ -49,8 +49,11 @@ impl Slave {
         // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
         // H = 2e-4 s). Input derivatives give continuous loads instead.
         let mut failed_probe = false;
+        self.jacobian_step = None;
+        let mut taken;
         let result = loop {
             let (n, h) = self.internal_steps(big_h, level)?;
+            taken = (n, h);
             self.prepare_step(h)?;
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -152,6 +155,7 @@ impl Slave {
                         ),
                     });
                 }
+                self.jacobian_step = Some(taken);
                 dynamics.ladder = if next != ladder.level {
                     Ladder::on(next)
                 } else if failed_probe {

@@ -34,6 +34,7 @@ use crate::linalg::{dot, SymmetricCsr};
 use nalgebra::Matrix3;
 
 mod consistent;
+pub mod sensitivity;
 mod step_change;
 pub use consistent::{initial_acceleration, restart_for_load_change};
 
@@ -374,13 +375,27 @@ fn predict(
     prev: &DynamicState,
     state: &mut DynamicState,
 ) {
+    predict_free(scheme, problem.free, h, prev, state);
+    state.time = prev.time + h;
+    (problem.prescribe)(state.time, state);
+    follow_prescribed_positions(scheme, problem.free, h, prev, state);
+}
+
+/// The predictor's free nodes ([`predict`]).
+fn predict_free(
+    scheme: &GeneralizedAlpha,
+    free: &FreeNodes,
+    h: f64,
+    prev: &DynamicState,
+    state: &mut DynamicState,
+) {
     let GeneralizedAlpha {
         alpha_m,
         alpha_f,
         beta,
         gamma,
     } = *scheme;
-    for &i in &problem.free.nodes {
+    for &i in &free.nodes {
         for d in 3 * i..3 * i + 3 {
             let acc = prev.acceleration[d];
             let a_new = (alpha_f * prev.acceleration[d] - alpha_m * prev.pseudo_acceleration[d]
@@ -394,9 +409,6 @@ fn predict(
             state.velocity[d] = prev.velocity[d] + h * ((1.0 - gamma) * a_old + gamma * a_new);
         }
     }
-    state.time = prev.time + h;
-    (problem.prescribe)(state.time, state);
-    follow_prescribed_positions(scheme, problem.free, h, prev, state);
 }
 
 /// The clamped nodes' velocities, accelerations and pseudo-accelerations at `t_{n+1}` from

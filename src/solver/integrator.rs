@@ -101,10 +101,13 @@ impl<T: Factorization> FactorCache<T> {
 
     /// The entry for `h` (prepared).
     fn get_mut(&mut self, h: f64) -> &mut T {
-        let i = self
-            .position(h)
-            .expect("the factorization of a step is prepared before the step");
-        &mut self.entries[i]
+        self.find_mut(h)
+            .expect("the factorization of a step is prepared before the step")
+    }
+
+    /// The entry for `h`, if there is one (the order of use is left as it is).
+    pub fn find_mut(&mut self, h: f64) -> Option<&mut T> {
+        self.position(h).map(|i| &mut self.entries[i])
     }
 
     /// The step sizes with an entry, most recently used last.
@@ -251,6 +254,14 @@ impl TimeIntegrator {
     pub fn iteration_matrix(&self, h: f64) -> Option<&IterationMatrix> {
         match self {
             TimeIntegrator::GeneralizedAlpha { cache, .. } => cache.get(h),
+            _ => None,
+        }
+    }
+
+    /// [`Self::iteration_matrix`], to solve with (its solve workspace changes).
+    pub fn iteration_matrix_mut(&mut self, h: f64) -> Option<&mut IterationMatrix> {
+        match self {
+            TimeIntegrator::GeneralizedAlpha { cache, .. } => cache.find_mut(h),
             _ => None,
         }
     }

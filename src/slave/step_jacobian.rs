@@ -1,0 +1,508 @@
+//! The step Jacobian (docs/coupling.md, "Jacobians"; docs/formulation.md, "The step Jacobian"):
+//! the derivative of outputs at the end of the last communication step with respect to inputs
+//! held over it, for masters that couple implicitly.
+
+use super::interfaces::apply_loads;
+use super::{Inputs, Slave};
+use crate::body::frame::set_node;
+use crate::body::interface::{DrivingFrame, NodeSet};
+use crate::error::{Error, Result};
+use crate::model::enumerations::{Formulation, Integrator};
+use crate::model::variables::{FixedKey, InterfaceQuantity};
+use crate::model::{Causality, InterfaceKind, Target, VariableType};
+use crate::solver::generalized_alpha::sensitivity::{linear_step, SensitivityWorkspace};
+use crate::solver::problem::{last_residual, residual, DynamicState, ResidualWorkspace};
+use nalgebra::{Matrix3, Rotation3, Vector3};
+
+/// The step Jacobian's vectors (allocated on its first use, with the model).
+pub(super) struct JacobianWorkspace {
+    /// The perturbation of the state `δs` carried through the step's internal steps.
+    perturbation: DynamicState,
+    solver: SensitivityWorkspace,
+    /// The perturbation of the external loads of a force seed (full `3N`).
+    load: Vec<f64>,
+    /// The end state and the loads while the outputs are evaluated about them.
+    saved: DynamicState,
+    saved_loads: Vec<Inputs>,
+    /// The residual's directional derivative: its own workspace (the model's holds the frames
+    /// the iteration matrix turns with) and the perturbed state.
+    forces: ResidualWorkspace,
+    probe: DynamicState,
+}
+
+/// The relative size of the perturbations along which the residual and the outputs are
+/// differentiated (central differences): `ε max(|δx|, |δẋ| h, |δẍ| h²) = 1e-6 × size`, far
+/// above round-off (the residual's differences are about 1e-9 of it) and small enough that the
+/// differences' own error (the curvature of the frames' rotations, of the set's best-fit motion)
+/// is below 1e-9 of the derivative with the residual's fourth-order and the outputs'
+/// second-order differences.
+const DIFFERENCE_STEP: f64 = 1e-6;
+
+/// The step `ε` of central differences along `ds` (see [`DIFFERENCE_STEP`]) on a body of
+/// `size`, velocities and accelerations weighed over the time `step` (the internal step for the
+/// residual, the communication step for the outputs).
+fn difference_step(ds: &DynamicState, size: f64, step: f64) -> f64 {
+    let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let reach = largest(&ds.position)
+        .max(largest(&ds.velocity) * step)
+        .max(largest(&ds.acceleration) * step * step);
+    if reach > 0.0 {
+        DIFFERENCE_STEP * size / reach
+    } else {
+        DIFFERENCE_STEP
+    }
+}
+
+/// `state = saved + ε ds` in positions, velocities and accelerations (the multipliers and the
+/// rest as saved).
+fn perturb(state: &mut DynamicState, saved: &DynamicState, ds: &DynamicState, epsilon: f64) {
+    state.copy_from(saved);
+    for (x, d) in [
+        (&mut state.position, &ds.position),
+        (&mut state.velocity, &ds.velocity),
+        (&mut state.acceleration, &ds.acceleration),
+    ] {
+        for (x, d) in x.iter_mut().zip(d.iter()) {
+            *x += epsilon * d;
+        }
+    }
+}
+
+/// What an input of the Jacobian perturbs.
+#[derive(Clone, Copy)]
+enum Seed {
+    /// A force interface's force (`torque` false) or torque component.
+    Load {
+        interface: usize,
+        torque: bool,
+        component: usize,
+    },
+    /// A motion interface's driving frame: position, rotation entry (row-major), velocity or
+    /// angular velocity component.
+    Frame {
+        interface: usize,
+        quantity: InterfaceQuantity,
+        component: usize,
+    },
+}
+
+impl Slave {
+    /// The step Jacobian of the last `fmi2DoStep` from `t₀` to `t₁ = t₀ + H`: `jacobian[i ×
+    /// inputs.len() + j]` (row-major) is the derivative of output `outputs[i]` at `t₁` with
+    /// respect to input `inputs[j]` at `t₀`, held over the step (extrapolated with the frame's
+    /// velocities for a motion interface), the state at `t₀` fixed: for a force interface its
+    /// dynamic compliance, for a motion interface its dynamic stiffness. Inputs: the `force` and
+    /// `torque` of force interfaces, the `position`, `rotation`, `velocity` and
+    /// `angularVelocity` of motion interfaces (a rotation entry seeds the rotation
+    /// `δQ = Q skew(Qᵀ E)` its change makes after the input's orthonormalization); outputs:
+    /// any. The state is linearised with the step's own iteration matrix (one solve per input
+    /// and internal step) and the outputs are differentiated about the end state; the state is
+    /// left as it was. Generalized-α with the reduced strain only, without pins, hinges or rigid
+    /// sets: otherwise an error saying which. No allocation after the first call.
+    pub fn step_jacobian(
+        &mut self,
+        outputs: &[u32],
+        inputs: &[u32],
+        jacobian: &mut [f64],
+    ) -> Result<()> {
+        if jacobian.len() != outputs.len() * inputs.len() {
+            return Err(Error::new(format!(
+                "the step Jacobian of {} outputs and {} inputs has {} entries, not {}",
+                outputs.len(),
+                inputs.len(),
+                outputs.len() * inputs.len(),
+                jacobian.len()
+            )));
+        }
+        let (steps, h) = self.jacobian_step.ok_or_else(|| {
+            Error::new(
+                "the step Jacobian describes the last fmi2DoStep: no step has been taken since the instance was initialized, reset or set to an FMU state",
+            )
+        })?;
+        self.check_jacobian_model()?;
+        for &vr in outputs {
+            self.jacobian_output(vr)?;
+        }
+        for &vr in inputs {
+            self.jacobian_seed(vr)?;
+        }
+        // The end state's outputs and, in the residual's scratch, its slabs' frames.
+        self.outputs.valid = false;
+        self.ensure_outputs()?;
+        let at = super::variables::body_output_slot(FixedKey::BodyRotation);
+        let frame = Matrix3::from_row_slice(&self.outputs.body[at..at + 9]);
+        if self.model.as_ref().unwrap().jacobian.is_none() {
+            let model = self.model.as_mut().unwrap();
+            let n3 = model.body.reference.len();
+            let multipliers = model.free.multiplier_count();
+            model.jacobian = Some(JacobianWorkspace {
+                perturbation: DynamicState::zeros(n3, multipliers),
+                solver: SensitivityWorkspace::new(&model.body, &model.free),
+                load: vec![0.0; n3],
+                saved: DynamicState::zeros(n3, multipliers),
+                saved_loads: self.inputs.clone(),
+                forces: ResidualWorkspace::new(&model.body),
+                probe: DynamicState::zeros(n3, multipliers),
+            });
+        }
+        let columns = inputs.len();
+        for (j, &vr) in inputs.iter().enumerate() {
+            let seed = self.jacobian_seed(vr)?;
+            self.propagate(seed, steps, h, &frame)?;
+            self.differentiate_outputs(seed, outputs, h * steps as f64, j, columns, jacobian)?;
+        }
+        // The outputs (and the residual's scratch) of the state as it is.
+        self.outputs.valid = false;
+        self.ensure_outputs()
+    }
+
+    /// Refuses models the step Jacobian does not cover, naming why.
+    fn check_jacobian_model(&self) -> Result<()> {
+        let p = &self.parameters;
+        if p.integrator != Integrator::GeneralizedAlpha {
+            return Err(Error::new(format!(
+                "the step Jacobian is computed with generalized-α's iteration matrix; solver.integrator = {} has none",
+                p.integrator.item()
+            )));
+        }
+        if p.formulation == Formulation::Full {
+            return Err(Error::new(
+                "the step Jacobian linearises the reduced-strain body; model.formulation = full is not supported",
+            ));
+        }
+        let free = &self.model.as_ref().expect("a step was taken").free;
+        if !free.constraints.is_empty() || !free.rigid.is_empty() {
+            let names: Vec<&str> = self
+                .body_file
+                .interfaces
+                .iter()
+                .filter(|i| i.rigid || matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge))
+                .map(|i| i.name.as_str())
+                .collect();
+            return Err(Error::new(format!(
+                "the step Jacobian does not cover Lagrange multipliers yet: pins, hinges and rigid sets ({}) are not supported",
+                names.join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks that `vr` is a Real output.
+    fn jacobian_output(&self, vr: u32) -> Result<()> {
+        match self.variables.get(VariableType::Real, vr) {
+            Some(v) if v.causality == Causality::Output => Ok(()),
+            Some(v) => Err(Error::new(format!(
+                "{} (value reference {vr}) is not an output: the step Jacobian's unknowns are outputs",
+                v.name
+            ))),
+            None => Err(Error::new(format!(
+                "no Real variable has value reference {vr}"
+            ))),
+        }
+    }
+
+    /// The seed of input `vr`, or an error naming what the Jacobian takes.
+    fn jacobian_seed(&self, vr: u32) -> Result<Seed> {
+        let v = self
+            .variables
+            .get(VariableType::Real, vr)
+            .ok_or_else(|| Error::new(format!("no Real variable has value reference {vr}")))?;
+        use InterfaceQuantity as Q;
+        match v.target {
+            Target::Interface {
+                index,
+                quantity: q @ (Q::Force | Q::Torque),
+                component,
+            } if v.causality == Causality::Input
+                && self.interfaces[index].kind == InterfaceKind::Force =>
+            {
+                Ok(Seed::Load {
+                    interface: index,
+                    torque: q == Q::Torque,
+                    component,
+                })
+            }
+            Target::Interface {
+                index,
+                quantity,
+                component,
+            } if v.causality == Causality::Input
+                && self.interfaces[index].kind == InterfaceKind::Motion =>
+            {
+                Ok(Seed::Frame {
+                    interface: index,
+                    quantity,
+                    component,
+                })
+            }
+            _ => Err(Error::new(format!(
+                "{} (value reference {vr}): the step Jacobian's knowns are the force and torque inputs of force interfaces and the position, rotation, velocity and angularVelocity inputs of motion interfaces",
+                v.name
+            ))),
+        }
+    }
+
+    /// `δs` at the step's end for `seed` (in the Jacobian workspace): the linearised internal
+    /// steps from `δs = 0` at its start, about the end state (each internal step's residual is
+    /// differentiated there: exact for one internal step, within the change of the state over
+    /// the communication step for several).
+    fn propagate(&mut self, seed: Seed, steps: usize, h: f64, frame: &Matrix3<f64>) -> Result<()> {
+        let model = self.model.as_mut().unwrap();
+        let JacobianWorkspace {
+            perturbation,
+            solver,
+            load,
+            saved,
+            forces,
+            probe,
+            ..
+        } = model.jacobian.as_mut().unwrap();
+        let (body, free) = (&model.body, &model.free);
+        let dynamics = self.dynamics.as_ref().unwrap();
+        saved.copy_from(&dynamics.state);
+        forces
+            .geometric_stiffness
+            .clone_from(&model.forces.geometric_stiffness);
+        load.fill(0.0);
+        if let Seed::Load {
+            interface,
+            torque,
+            component,
+        } = seed
+        {
+            let unit = Vector3::ith(component, 1.0);
+            let (f, t) = if torque {
+                (Vector3::zeros(), unit)
+            } else {
+                (unit, Vector3::zeros())
+            };
+            self.interfaces[interface]
+                .set
+                .distribute(&saved.position, &f, &t, load);
+        }
+        let driven = match seed {
+            Seed::Frame {
+                interface,
+                quantity,
+                component,
+            } => Some((
+                &self.interfaces[interface].set,
+                self.driving[interface],
+                quantity,
+                component,
+            )),
+            Seed::Load { .. } => None,
+        };
+        let reference = &body.reference;
+        let prescribe = |tau: f64, ds: &mut DynamicState| {
+            if let Some((set, frame, quantity, component)) = driven {
+                frame_perturbation(set, reference, &frame, quantity, component, tau, ds);
+            }
+        };
+        // The residual's directional derivative at the end state, by central differences of
+        // the residual with the step's loads; less the seed's load.
+        let gravity = Vector3::from(dynamics.gravity);
+        let (interfaces, held) = (&self.interfaces, &dynamics.loads);
+        let loads =
+            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, held, None, &gravity, x, f);
+        let size = self.size;
+        let load = &*load;
+        let saved = &*saved;
+        let mut derivative = |ds: &DynamicState, out: &mut [f64]| {
+            // Fourth-order central differences, (8 (r₊ − r₋) − (r₊₊ − r₋₋)) / 12ε: the
+            // frames' rotations make the residual curved enough that the two-point difference
+            // at a step above its noise is 4e-6 off (B1's torsion).
+            let epsilon = difference_step(ds, size, h);
+            out.fill(0.0);
+            for (multiple, weight) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
+                perturb(probe, saved, ds, multiple * epsilon);
+                residual(body, free, probe, &loads, forces);
+                let r = last_residual(forces);
+                for (o, r) in out.iter_mut().zip(r) {
+                    *o += weight * r;
+                }
+            }
+            for (o, f) in out.iter_mut().zip(load) {
+                *o = *o / (12.0 * epsilon) - f;
+            }
+        };
+        let matrix = model.integrator.iteration_matrix_mut(h).ok_or_else(|| {
+            Error::new(format!(
+                "the iteration matrix of the last step (h = {h:e} s) is no longer cached"
+            ))
+        })?;
+        let ds = perturbation;
+        for v in [
+            &mut ds.position,
+            &mut ds.velocity,
+            &mut ds.acceleration,
+            &mut ds.pseudo_acceleration,
+        ] {
+            v.fill(0.0);
+        }
+        ds.time = 0.0;
+        for _ in 0..steps {
+            linear_step(
+                matrix,
+                body,
+                free,
+                frame,
+                &model.forces,
+                h,
+                &prescribe,
+                &mut derivative,
+                ds,
+                solver,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Column `j` of the Jacobian: the outputs differentiated (central differences) about the
+    /// end state along `δs` and, for a force seed, the load input.
+    fn differentiate_outputs(
+        &mut self,
+        seed: Seed,
+        outputs: &[u32],
+        big_h: f64,
+        j: usize,
+        columns: usize,
+        jacobian: &mut [f64],
+    ) -> Result<()> {
+        let model = self.model.as_mut().unwrap();
+        let ws = model.jacobian.as_mut().unwrap();
+        let dynamics = self.dynamics.as_mut().unwrap();
+        ws.saved.copy_from(&dynamics.state);
+        ws.saved_loads.clone_from(&dynamics.loads);
+        let epsilon = difference_step(&ws.perturbation, self.size, big_h);
+        let load_seed = match seed {
+            Seed::Load {
+                interface,
+                torque,
+                component,
+            } => Some((
+                interface,
+                InterfaceQuantity::Force.slot() as usize + 3 * usize::from(torque) + component,
+            )),
+            Seed::Frame { .. } => None,
+        };
+        let mut result = Ok(());
+        for sign in [1.0, -1.0] {
+            let model = self.model.as_mut().unwrap();
+            let ws = model.jacobian.as_mut().unwrap();
+            let dynamics = self.dynamics.as_mut().unwrap();
+            perturb(
+                &mut dynamics.state,
+                &ws.saved,
+                &ws.perturbation,
+                sign * epsilon,
+            );
+            if let Some((k, slot)) = load_seed {
+                dynamics.loads[k][slot] = ws.saved_loads[k][slot] + sign * epsilon;
+            }
+            self.outputs.valid = false;
+            for (i, &vr) in outputs.iter().enumerate() {
+                match self.get_real(vr) {
+                    Ok(y) if sign > 0.0 => jacobian[i * columns + j] = y,
+                    Ok(y) => {
+                        let entry = &mut jacobian[i * columns + j];
+                        *entry = (*entry - y) / (2.0 * epsilon);
+                    }
+                    Err(e) => result = Err(e),
+                }
+            }
+        }
+        let model = self.model.as_mut().unwrap();
+        let ws = model.jacobian.as_ref().unwrap();
+        let dynamics = self.dynamics.as_mut().unwrap();
+        dynamics.state.copy_from(&ws.saved);
+        dynamics.loads.clone_from(&ws.saved_loads);
+        self.outputs.valid = false;
+        result
+    }
+}
+
+/// The perturbation of motion interface `set`'s held coordinates `τ` into the step when its
+/// driving frame `frame` (at the step's start) has its input `quantity[component]` changed by
+/// one unit: `x = p + v τ + exp([ω τ]×) Q d` (`Q d` for a direction) differentiated.
+fn frame_perturbation(
+    set: &NodeSet,
+    reference: &[f64],
+    frame: &DrivingFrame,
+    quantity: InterfaceQuantity,
+    component: usize,
+    tau: f64,
+    ds: &mut DynamicState,
+) {
+    use InterfaceQuantity as Q;
+    let turn = *Rotation3::from_scaled_axis(frame.angular_velocity * tau).matrix();
+    let q = frame.rotation;
+    let unit = Vector3::ith(component % 3, 1.0);
+    // δ(Q d) = D d, and δp for a point.
+    let (rotation_change, point_change) = match quantity {
+        Q::Position => (Matrix3::zeros(), unit),
+        Q::Velocity => (Matrix3::zeros(), tau * unit),
+        Q::Rotation => {
+            let e = Matrix3::from_fn(|r, c| f64::from(u8::from(3 * r + c == component)));
+            let a = q.transpose() * e;
+            (turn * q * (0.5 * (a - a.transpose())), Vector3::zeros())
+        }
+        Q::AngularVelocity => {
+            let w = left_jacobian(&(frame.angular_velocity * tau)) * (tau * unit);
+            (w.cross_matrix() * turn * q, Vector3::zeros())
+        }
+        _ => (Matrix3::zeros(), Vector3::zeros()),
+    };
+    set.for_each_held(reference, |index, offset, point| {
+        let mut dx = rotation_change * offset;
+        if point {
+            dx += point_change;
+        }
+        set_node(&mut ds.position, index, &dx);
+    });
+}
+
+/// The left Jacobian of the rotation vector `φ`: `exp([φ + δ]×) = exp([J_l(φ) δ]×) exp([φ]×)` to
+/// first order, `J_l = I + (1 − cos θ)/θ² [φ]× + (θ − sin θ)/θ³ [φ]×²`, `θ = |φ|`.
+fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let theta = phi.norm();
+    let k = phi.cross_matrix();
+    let (a, b) = if theta < 1e-4 {
+        (
+            0.5 - theta * theta / 24.0,
+            1.0 / 6.0 - theta * theta / 120.0,
+        )
+    } else {
+        (
+            (1.0 - theta.cos()) / (theta * theta),
+            (theta - theta.sin()) / (theta * theta * theta),
+        )
+    };
+    Matrix3::identity() + a * k + b * k * k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_left_jacobian_is_the_derivative_of_the_exponential() {
+        for phi in [
+            Vector3::new(0.3, -0.2, 1.1),
+            Vector3::new(1e-6, 2e-6, -1e-6),
+        ] {
+            let j = left_jacobian(&phi);
+            let exp = |v: Vector3<f64>| *Rotation3::from_scaled_axis(v).matrix();
+            for c in 0..3 {
+                let e = 1e-6;
+                let d = Vector3::ith(c, e);
+                let numeric = (exp(phi + d) - exp(phi - d)) / (2.0 * e);
+                let analytic = (j * Vector3::ith(c, 1.0)).cross_matrix() * exp(phi);
+                assert!(
+                    (numeric - analytic).amax() < 1e-9,
+                    "φ = {phi:?}, component {c}: {numeric} against {analytic}"
+                );
+            }
+        }
+    }
+}
