@@ -277,3 +277,74 @@ fn every_output_can_be_read_in_every_readable_state() {
         fmi2FreeInstance(c);
     }
 }
+
+/// `flexbody_GetStepJacobian` (docs/coupling.md, "Jacobians"): the same numbers as the slave's
+/// `step_jacobian` after the same steps; in StepComplete only, with Real outputs as unknowns and
+/// Real inputs as knowns, NULL arrays refused; a refused call leaves the instance stepping.
+#[test]
+fn the_step_jacobian_through_the_c_abi() {
+    let recorder = Recorder::default();
+    let functions = callbacks(&recorder);
+    let c = new_instance(&recorder, &functions);
+    let (unknowns, knowns) = ([TIP_Z, 1002], [TIP_FZ, 1101]);
+    let mut jacobian = [0.0; 4];
+    let call = |c, u: &[u32], k: &[u32], j: &mut [f64]| unsafe {
+        flexbody_GetStepJacobian(c, u.as_ptr(), u.len(), k.as_ptr(), k.len(), j.as_mut_ptr())
+    };
+    // Before initialization: the calling sequence.
+    assert_eq!(call(c, &unknowns, &knowns, &mut jacobian), ERR);
+    assert!(
+        recorder.last_text().contains("flexbody_GetStepJacobian"),
+        "{}",
+        recorder.last_text()
+    );
+    initialize(c, -10.0);
+    steps(c, 0.0, 5);
+    assert_eq!(
+        call(c, &unknowns, &knowns, &mut jacobian),
+        OK,
+        "{:?}",
+        recorder.texts()
+    );
+    // The slave's own after the same run.
+    let mut s = Slave::from_resources(None).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.set_real(TIP_FZ, -10.0).unwrap();
+    s.exit_initialization_mode().unwrap();
+    for k in 0..5 {
+        s.do_step(k as f64 * H, H).unwrap();
+    }
+    let mut expected = [0.0; 4];
+    s.step_jacobian(&unknowns, &knowns, &mut expected).unwrap();
+    assert_eq!(jacobian, expected);
+    assert!(
+        jacobian[0] > 0.0,
+        "a force along z moves the tip along z: {jacobian:?}"
+    );
+    // Knowns must be inputs, unknowns outputs; NULL with a count is refused.
+    assert_eq!(call(c, &[TIP_FZ], &knowns, &mut jacobian[..2]), ERR);
+    assert!(
+        recorder.last_text().contains("is not an output"),
+        "{}",
+        recorder.last_text()
+    );
+    assert_eq!(call(c, &unknowns, &[TIP_Z], &mut jacobian[..2]), ERR);
+    assert!(
+        recorder.last_text().contains("is not an input"),
+        "{}",
+        recorder.last_text()
+    );
+    let status = unsafe {
+        flexbody_GetStepJacobian(c, null_mut(), 2, knowns.as_ptr(), 2, jacobian.as_mut_ptr())
+    };
+    assert_eq!(status, ERR);
+    assert!(
+        recorder.last_text().contains("NULL"),
+        "{}",
+        recorder.last_text()
+    );
+    // The instance steps on.
+    steps(c, 5.0 * H, 1);
+    unsafe { fmi2FreeInstance(c) };
+}

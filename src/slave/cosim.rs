@@ -70,6 +70,17 @@ pub trait CoSimSlave {
     ) -> Result<()>;
     /// `fmi2GetRealOutputDerivatives` for one output.
     fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64>;
+    /// The step Jacobian of the last step (`flexbody_GetStepJacobian`, see
+    /// [`Slave::step_jacobian`]); default: none.
+    fn step_jacobian(
+        &mut self,
+        outputs: &[u32],
+        inputs: &[u32],
+        jacobian: &mut [f64],
+    ) -> Result<()> {
+        let _ = (outputs, inputs, jacobian);
+        Err(crate::Error::new("this slave has no step Jacobian"))
+    }
     /// Hands the slave's pending log messages (category, text) to `sink`.
     fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
         let _ = sink;
@@ -159,6 +170,14 @@ impl CoSimSlave for Slave {
     }
     fn get_real_output_derivative(&mut self, vr: u32, order: i32) -> Result<f64> {
         Slave::get_real_output_derivative(self, vr, order)
+    }
+    fn step_jacobian(
+        &mut self,
+        outputs: &[u32],
+        inputs: &[u32],
+        jacobian: &mut [f64],
+    ) -> Result<()> {
+        Slave::step_jacobian(self, outputs, inputs, jacobian)
     }
     fn drain_events(&mut self, sink: &mut dyn FnMut(&'static str, &str)) {
         for e in Slave::drain_events(self) {

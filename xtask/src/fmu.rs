@@ -277,7 +277,7 @@ pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
     host.sort();
     if windows != host || host.is_empty() {
         return Err(format!(
-            "{} exports {windows:?}, {} exports {host:?}: the two binaries of the .fmu must export the same fmi2 and fmi3 functions",
+            "{} exports {windows:?}, {} exports {host:?}: the two binaries of the .fmu must export the same fmi2, fmi3 and flexbody_ functions",
             dll.display(),
             library.display()
         ));
@@ -285,8 +285,9 @@ pub fn check_windows_exports(dll: &Path, library: &Path) -> Result<usize> {
     Ok(host.len())
 }
 
+/// The functions an importer calls: FMI 2.0's, FMI 3.0's and ours (`flexbody_GetStepJacobian`).
 fn is_fmi_function(name: &str) -> bool {
-    name.starts_with("fmi2") || name.starts_with("fmi3")
+    name.starts_with("fmi2") || name.starts_with("fmi3") || name.starts_with("flexbody_")
 }
 
 /// The `DLL Name:` entries of an `objdump -p` listing.

@@ -32,6 +32,43 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     })
 }
 
+/// `flexbody_GetStepJacobian` (not an FMI function; docs/coupling.md, "Jacobians"): the step
+/// Jacobian of the last `fmi2DoStep`, `jacobian[i * nKnown + j] = ∂ vUnknown_ref[i] (t₁) / ∂
+/// vKnown_ref[j] (t₀)` (row-major), the derivative of outputs at the step's end with respect to
+/// inputs held over it, the state at its start fixed. FMI 2.0's `fmi2GetDirectionalDerivative`
+/// in co-simulation is the derivative at one instant, which this body's outputs do not have with
+/// respect to its inputs; the step Jacobian is what an implicit coupling needs, so it comes as a
+/// function of its own, exported beside the FMI 2.0 functions (`ctypes` or `dlsym` reach it).
+#[no_mangle]
+pub unsafe extern "C" fn flexbody_GetStepJacobian(
+    c: fmi2Component,
+    vUnknown_ref: *const fmi2ValueReference,
+    nUnknown: usize,
+    vKnown_ref: *const fmi2ValueReference,
+    nKnown: usize,
+    jacobian: *mut fmi2Real,
+) -> fmi2Status {
+    const F: &str = "flexbody_GetStepJacobian";
+    call(c, F, |inst| {
+        let size = nUnknown.checked_mul(nKnown);
+        match (
+            slice_in(vUnknown_ref, nUnknown),
+            slice_in(vKnown_ref, nKnown),
+            size.and_then(|n| slice_out(jacobian, n)),
+        ) {
+            (Some(unknowns), Some(knowns), Some(values)) => {
+                inst.step_jacobian(unknowns, knowns, values)
+            }
+            _ => inst.fail(
+                F,
+                &format!(
+                    "vUnknown_ref, vKnown_ref or jacobian is NULL (or too large) with nUnknown = {nUnknown}, nKnown = {nKnown}"
+                ),
+            ),
+        }
+    })
+}
+
 // ---------------------------------------------------------------------------------------------
 // Co-simulation
 

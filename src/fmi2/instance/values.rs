@@ -1,7 +1,7 @@
 //! Typed access to the slave's variables for `fmi2Get*`/`fmi2Set*`, and which variables may be
 //! set in which state.
 
-use super::{CoSimSlave, Instance, MachineState, GET, M, OUTPUT_DERIVATIVES, SET};
+use super::{CoSimSlave, Instance, MachineState, DO_STEP, GET, M, OUTPUT_DERIVATIVES, SET};
 use crate::error::Result;
 use crate::fmi2::types::fmi2Status;
 use crate::model::{Causality, Variability, Variable, VariableType};
@@ -354,5 +354,48 @@ impl<S: CoSimSlave> Instance<S> {
             }
         }
         fmi2Status::fmi2OK
+    }
+
+    /// `flexbody_GetStepJacobian`: the step Jacobian of the last `fmi2DoStep` (see
+    /// [`crate::slave::Slave::step_jacobian`]), row-major, in StepComplete. The value
+    /// references are checked here (Real outputs, Real inputs); the slave checks what its
+    /// Jacobian covers. On error the instance is as it was (`jacobian`'s entries unspecified).
+    pub fn step_jacobian(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        jacobian: &mut [f64],
+    ) -> fmi2Status {
+        const F: &str = "flexbody_GetStepJacobian";
+        if let Err(s) = self.check_state(F, DO_STEP) {
+            return s;
+        }
+        for (&vr, causality, role) in unknowns
+            .iter()
+            .map(|vr| (vr, Causality::Output, "an output (unknown)"))
+            .chain(
+                knowns
+                    .iter()
+                    .map(|vr| (vr, Causality::Input, "an input (known)")),
+            )
+        {
+            let reason = match self.lookup(VariableType::Real, vr) {
+                Ok(v) if v.causality != causality => {
+                    Some(format!("{} (value reference {vr}) is not {role}", v.name))
+                }
+                Ok(_) => None,
+                Err(e) => Some(e),
+            };
+            if let Some(reason) = reason {
+                return self.fail(F, &reason);
+            }
+        }
+        let result = self.slave.step_jacobian(unknowns, knowns, jacobian);
+        self.flush_events();
+        match result {
+            Ok(()) if jacobian.iter().all(|x| x.is_finite()) => fmi2Status::fmi2OK,
+            Ok(()) => self.fail(F, "the step Jacobian is not finite"),
+            Err(e) => self.report(F, &e),
+        }
     }
 }
