@@ -142,9 +142,11 @@ pub struct Slave {
     /// The communication step last taken (0 before the first): a step within ulps of it is
     /// taken as it (see `snapped_step`).
     last_step_size: f64,
-    /// The internal steps (count, length) of the last `fmi2DoStep`, for its step Jacobian
-    /// (`None` before the first step and after a reset, an FMU state set or a failed step).
-    jacobian_step: Option<(usize, f64)>,
+    /// The last `fmi2DoStep` as its step Jacobian redoes it (`None` before the first step and
+    /// after a reset, an FMU state set or a failed step), and the inputs it was taken with
+    /// (copied at every step: the importer may set the next ones before asking).
+    jacobian_step: Option<step_jacobian::LastStep>,
+    step_inputs: step_jacobian::StepInputs,
     /// The driving frames of motion interfaces at the start of the current step.
     driving: Vec<DrivingFrame>,
     start_time: f64,
@@ -247,6 +249,7 @@ impl Slave {
             input_ages: vec![0.0; n_interfaces],
             last_step_size: 0.0,
             jacobian_step: None,
+            step_inputs: step_jacobian::StepInputs::default(),
             driving: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,

@@ -8,26 +8,62 @@ use crate::body::frame::set_node;
 use crate::body::interface::{DrivingFrame, NodeSet};
 use crate::error::{Error, Result};
 use crate::model::enumerations::{Formulation, Integrator};
-use crate::model::variables::{FixedKey, InterfaceQuantity};
+use crate::model::variables::InterfaceQuantity;
 use crate::model::{Causality, InterfaceKind, Target, VariableType};
 use crate::solver::generalized_alpha::sensitivity::{linear_step, SensitivityWorkspace};
 use crate::solver::problem::{last_residual, residual, DynamicState, ResidualWorkspace};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
-/// The step Jacobian's vectors (allocated on its first use, with the model).
+/// The step Jacobian's vectors (allocated on its first use, with the model; more perturbations
+/// when more inputs are asked for than before).
 pub(super) struct JacobianWorkspace {
-    /// The perturbation of the state `δs` carried through the step's internal steps.
-    perturbation: DynamicState,
+    /// Per input, the perturbation of the state `δs` carried through the step's internal steps.
+    perturbations: Vec<DynamicState>,
     solver: SensitivityWorkspace,
     /// The perturbation of the external loads of a force seed (full `3N`).
     load: Vec<f64>,
-    /// The end state and the loads while the outputs are evaluated about them.
+    /// The end state and the loads while the step is redone and the outputs are evaluated.
     saved: DynamicState,
     saved_loads: Vec<Inputs>,
     /// The residual's directional derivative: its own workspace (the model's holds the frames
     /// the iteration matrix turns with) and the perturbed state.
     forces: ResidualWorkspace,
     probe: DynamicState,
+}
+
+/// The last communication step: `steps` internal steps of `step` from `start` over `length`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LastStep {
+    pub(super) steps: usize,
+    pub(super) step: f64,
+    pub(super) start: f64,
+    pub(super) length: f64,
+}
+
+/// The inputs a communication step was taken with: the inputs, their derivatives and how old
+/// they were at its start (`Slave::input_ages`).
+#[derive(Debug, Clone, Default)]
+pub(super) struct StepInputs {
+    inputs: Vec<Inputs>,
+    derivatives: Vec<super::InputDerivatives>,
+    ages: Vec<f64>,
+}
+
+impl StepInputs {
+    /// Copies the step's inputs (no allocation after the first step).
+    pub(super) fn copy_from(
+        &mut self,
+        inputs: &[Inputs],
+        derivatives: &[super::InputDerivatives],
+        ages: &[f64],
+    ) {
+        self.inputs.clear();
+        self.inputs.extend_from_slice(inputs);
+        self.derivatives.clear();
+        self.derivatives.extend_from_slice(derivatives);
+        self.ages.clear();
+        self.ages.extend_from_slice(ages);
+    }
 }
 
 /// The relative size of the perturbations along which the residual and the outputs are
@@ -37,6 +73,12 @@ pub(super) struct JacobianWorkspace {
 /// is below 1e-9 of the derivative with the residual's fourth-order and the outputs'
 /// second-order differences.
 const DIFFERENCE_STEP: f64 = 1e-6;
+
+/// The outputs' differences take ten times the residual's step: their second-order differences
+/// of the support's reaction (the stiffness times positions of 1 m, round-off about 1e-7 N)
+/// were the noise that limited the reactions' derivatives to 6e-5 of their scale at the
+/// residual's step; at ten times it is 5e-6, and their curvature error still below that.
+const OUTPUT_DIFFERENCE: f64 = 10.0;
 
 /// The step `ε` of central differences along `ds` (see [`DIFFERENCE_STEP`]) on a body of
 /// `size`, velocities and accelerations weighed over the time `step` (the internal step for the
@@ -114,7 +156,7 @@ impl Slave {
                 jacobian.len()
             )));
         }
-        let (steps, h) = self.jacobian_step.ok_or_else(|| {
+        let last = self.jacobian_step.ok_or_else(|| {
             Error::new(
                 "the step Jacobian describes the last fmi2DoStep: no step has been taken since the instance was initialized, reset or set to an FMU state",
             )
@@ -126,34 +168,109 @@ impl Slave {
         for &vr in inputs {
             self.jacobian_seed(vr)?;
         }
-        // The end state's outputs and, in the residual's scratch, its slabs' frames.
-        self.outputs.valid = false;
-        self.ensure_outputs()?;
-        let at = super::variables::body_output_slot(FixedKey::BodyRotation);
-        let frame = Matrix3::from_row_slice(&self.outputs.body[at..at + 9]);
-        if self.model.as_ref().unwrap().jacobian.is_none() {
-            let model = self.model.as_mut().unwrap();
-            let n3 = model.body.reference.len();
-            let multipliers = model.free.multiplier_count();
-            model.jacobian = Some(JacobianWorkspace {
-                perturbation: DynamicState::zeros(n3, multipliers),
-                solver: SensitivityWorkspace::new(&model.body, &model.free),
-                load: vec![0.0; n3],
-                saved: DynamicState::zeros(n3, multipliers),
-                saved_loads: self.inputs.clone(),
-                forces: ResidualWorkspace::new(&model.body),
-                probe: DynamicState::zeros(n3, multipliers),
-            });
-        }
+        self.prepare_jacobian_workspace(inputs.len());
+        let result = self.redo_with_perturbations(inputs, last);
         let columns = inputs.len();
-        for (j, &vr) in inputs.iter().enumerate() {
-            let seed = self.jacobian_seed(vr)?;
-            self.propagate(seed, steps, h, &frame)?;
-            self.differentiate_outputs(seed, outputs, h * steps as f64, j, columns, jacobian)?;
-        }
+        let result = result.and_then(|()| {
+            for (j, &vr) in inputs.iter().enumerate() {
+                let seed = self.jacobian_seed(vr)?;
+                self.differentiate_outputs(seed, outputs, last.length, j, columns, jacobian)?;
+            }
+            Ok(())
+        });
         // The outputs (and the residual's scratch) of the state as it is.
         self.outputs.valid = false;
-        self.ensure_outputs()
+        result.and_then(|()| self.ensure_outputs())
+    }
+
+    /// The workspace, with a perturbation per input.
+    fn prepare_jacobian_workspace(&mut self, inputs: usize) {
+        let model = self.model.as_mut().unwrap();
+        let n3 = model.body.reference.len();
+        let multipliers = model.free.multiplier_count();
+        let ws = model.jacobian.get_or_insert_with(|| JacobianWorkspace {
+            perturbations: Vec::new(),
+            solver: SensitivityWorkspace::new(&model.body, &model.free),
+            load: vec![0.0; n3],
+            saved: DynamicState::zeros(n3, multipliers),
+            saved_loads: self.inputs.clone(),
+            forces: ResidualWorkspace::new(&model.body),
+            probe: DynamicState::zeros(n3, multipliers),
+        });
+        while ws.perturbations.len() < inputs {
+            ws.perturbations.push(DynamicState::zeros(n3, multipliers));
+        }
+        for ds in &mut ws.perturbations[..inputs] {
+            for v in [
+                &mut ds.position,
+                &mut ds.velocity,
+                &mut ds.acceleration,
+                &mut ds.pseudo_acceleration,
+            ] {
+                v.fill(0.0);
+            }
+            ds.time = 0.0;
+        }
+        ws.forces
+            .geometric_stiffness
+            .clone_from(&model.forces.geometric_stiffness);
+    }
+
+    /// Redoes the last communication step from its start (the backup) with the inputs it was
+    /// taken with, internal step by internal step as it was taken, and after each carries every
+    /// input's perturbation through the same internal step linearised about the state it
+    /// reached. The redo reaches the end state again (the same arithmetic); the state, the
+    /// inputs, the counters and the log are put back as they were, whatever happens.
+    fn redo_with_perturbations(&mut self, inputs: &[u32], last: LastStep) -> Result<()> {
+        {
+            let ws = self.model.as_mut().unwrap().jacobian.as_mut().unwrap();
+            let dynamics = self.dynamics.as_mut().unwrap();
+            ws.saved.copy_from(&dynamics.state);
+            ws.saved_loads.clone_from(&dynamics.loads);
+            dynamics
+                .state
+                .copy_from(self.backup.as_ref().expect("a step was taken"));
+        }
+        let counters = (
+            self.statistics,
+            self.retries,
+            self.step_error,
+            self.events.len(),
+        );
+        self.swap_step_inputs();
+        let mut result = Ok(());
+        for i in 0..last.steps {
+            result = self
+                .internal_step(last.start, last.length, i, last.steps, last.step)
+                .and_then(|()| {
+                    for (j, &vr) in inputs.iter().enumerate() {
+                        let seed = self.jacobian_seed(vr)?;
+                        self.linearised_step(seed, j, last.step)?;
+                    }
+                    Ok(())
+                });
+            if result.is_err() {
+                break;
+            }
+        }
+        self.swap_step_inputs();
+        (self.statistics, self.retries, self.step_error) = (counters.0, counters.1, counters.2);
+        self.events.truncate(counters.3);
+        let ws = self.model.as_mut().unwrap().jacobian.as_mut().unwrap();
+        let dynamics = self.dynamics.as_mut().unwrap();
+        dynamics.state.copy_from(&ws.saved);
+        dynamics.loads.clone_from(&ws.saved_loads);
+        result
+    }
+
+    /// Exchanges the current inputs with those the last step was taken with (twice: back).
+    fn swap_step_inputs(&mut self) {
+        std::mem::swap(&mut self.inputs, &mut self.step_inputs.inputs);
+        std::mem::swap(
+            &mut self.input_derivatives,
+            &mut self.step_inputs.derivatives,
+        );
+        std::mem::swap(&mut self.input_ages, &mut self.step_inputs.ages);
     }
 
     /// Refuses models the step Jacobian does not cover, naming why.
@@ -242,27 +359,42 @@ impl Slave {
         }
     }
 
-    /// `δs` at the step's end for `seed` (in the Jacobian workspace): the linearised internal
-    /// steps from `δs = 0` at its start, about the end state (each internal step's residual is
-    /// differentiated there: exact for one internal step, within the change of the state over
-    /// the communication step for several).
-    fn propagate(&mut self, seed: Seed, steps: usize, h: f64, frame: &Matrix3<f64>) -> Result<()> {
+    /// Input `j`'s perturbation (seed `seed`) carried through one internal step of `h`,
+    /// linearised about the state it reached (the current one).
+    fn linearised_step(&mut self, seed: Seed, j: usize, h: f64) -> Result<()> {
+        let start = self.jacobian_step.map_or(0.0, |l| l.start);
         let model = self.model.as_mut().unwrap();
         let JacobianWorkspace {
-            perturbation,
+            perturbations,
             solver,
             load,
-            saved,
             forces,
             probe,
             ..
         } = model.jacobian.as_mut().unwrap();
         let (body, free) = (&model.body, &model.free);
         let dynamics = self.dynamics.as_ref().unwrap();
-        saved.copy_from(&dynamics.state);
-        forces
-            .geometric_stiffness
-            .clone_from(&model.forces.geometric_stiffness);
+        let state = &dynamics.state;
+        let gravity = Vector3::from(self.parameters.gravity);
+        let (interfaces, inputs) = (&self.interfaces, &self.inputs);
+        let (derivatives, ages) = (&self.input_derivatives, &self.input_ages);
+        // The loads as the internal step just taken had them (the step's inputs at its end).
+        let tau = state.time - start;
+        let loads = |x: &[f64], f: &mut [f64]| {
+            apply_loads(
+                body,
+                interfaces,
+                inputs,
+                Some((derivatives, ages, tau)),
+                &gravity,
+                x,
+                f,
+            )
+        };
+        // The frames the iteration matrix turns with, at this state.
+        let frame = residual(body, free, state, &loads, &mut model.forces)
+            .frame
+            .rotation;
         load.fill(0.0);
         if let Seed::Load {
             interface,
@@ -278,7 +410,7 @@ impl Slave {
             };
             self.interfaces[interface]
                 .set
-                .distribute(&saved.position, &f, &t, load);
+                .distribute(&state.position, &f, &t, load);
         }
         let driven = match seed {
             Seed::Frame {
@@ -299,15 +431,9 @@ impl Slave {
                 frame_perturbation(set, reference, &frame, quantity, component, tau, ds);
             }
         };
-        // The residual's directional derivative at the end state, by central differences of
-        // the residual with the step's loads; less the seed's load.
-        let gravity = Vector3::from(dynamics.gravity);
-        let (interfaces, held) = (&self.interfaces, &dynamics.loads);
-        let loads =
-            |x: &[f64], f: &mut [f64]| apply_loads(body, interfaces, held, None, &gravity, x, f);
+        // The residual's directional derivative at this state, less the seed's load.
         let size = self.size;
         let load = &*load;
-        let saved = &*saved;
         let mut derivative = |ds: &DynamicState, out: &mut [f64]| {
             // Fourth-order central differences, (8 (r₊ − r₋) − (r₊₊ − r₋₋)) / 12ε: the
             // frames' rotations make the residual curved enough that the two-point difference
@@ -315,7 +441,7 @@ impl Slave {
             let epsilon = difference_step(ds, size, h);
             out.fill(0.0);
             for (multiple, weight) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
-                perturb(probe, saved, ds, multiple * epsilon);
+                perturb(probe, state, ds, multiple * epsilon);
                 residual(body, free, probe, &loads, forces);
                 let r = last_residual(forces);
                 for (o, r) in out.iter_mut().zip(r) {
@@ -331,30 +457,18 @@ impl Slave {
                 "the iteration matrix of the last step (h = {h:e} s) is no longer cached"
             ))
         })?;
-        let ds = perturbation;
-        for v in [
-            &mut ds.position,
-            &mut ds.velocity,
-            &mut ds.acceleration,
-            &mut ds.pseudo_acceleration,
-        ] {
-            v.fill(0.0);
-        }
-        ds.time = 0.0;
-        for _ in 0..steps {
-            linear_step(
-                matrix,
-                body,
-                free,
-                frame,
-                &model.forces,
-                h,
-                &prescribe,
-                &mut derivative,
-                ds,
-                solver,
-            )?;
-        }
+        linear_step(
+            matrix,
+            body,
+            free,
+            &frame,
+            &model.forces,
+            h,
+            &prescribe,
+            &mut derivative,
+            &mut perturbations[j],
+            solver,
+        )?;
         Ok(())
     }
 
@@ -374,7 +488,7 @@ impl Slave {
         let dynamics = self.dynamics.as_mut().unwrap();
         ws.saved.copy_from(&dynamics.state);
         ws.saved_loads.clone_from(&dynamics.loads);
-        let epsilon = difference_step(&ws.perturbation, self.size, big_h);
+        let epsilon = OUTPUT_DIFFERENCE * difference_step(&ws.perturbations[j], self.size, big_h);
         let load_seed = match seed {
             Seed::Load {
                 interface,
@@ -394,7 +508,7 @@ impl Slave {
             perturb(
                 &mut dynamics.state,
                 &ws.saved,
-                &ws.perturbation,
+                &ws.perturbations[j],
                 sign * epsilon,
             );
             if let Some((k, slot)) = load_seed {

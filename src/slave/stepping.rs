@@ -43,6 +43,8 @@ impl Slave {
         let mut level = ladder.level - u32::from(probing);
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
         self.inputs_jumped = self.update_driving_frames()?;
+        self.step_inputs
+            .copy_from(&self.inputs, &self.input_derivatives, &self.input_ages);
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
         // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
@@ -155,7 +157,12 @@ impl Slave {
                         ),
                     });
                 }
-                self.jacobian_step = Some(taken);
+                self.jacobian_step = Some(super::step_jacobian::LastStep {
+                    steps: taken.0,
+                    step: taken.1,
+                    start: t0,
+                    length: big_h,
+                });
                 dynamics.ladder = if next != ladder.level {
                     Ladder::on(next)
                 } else if failed_probe {

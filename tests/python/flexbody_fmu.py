@@ -7,7 +7,7 @@ files each message under the instance name, and each instance gets its own
 ``componentEnvironment`` so the tests can check that the FMU passes it back.
 """
 
-from ctypes import byref
+from ctypes import POINTER, byref, c_double, c_int, c_size_t, c_uint, c_void_p
 from dataclasses import dataclass
 
 import numpy as np
@@ -137,6 +137,21 @@ class Instance:
             self.time += h
             rows.append(self.outputs())
         return np.array(rows)
+
+    def step_jacobian(self, outputs, inputs) -> np.ndarray:
+        """`flexbody_GetStepJacobian` (docs/coupling.md, "Jacobians"): the derivative of the
+        outputs (names) at the end of the last doStep with respect to the inputs (names) held
+        over it, as a matrix with a row per output."""
+        f = self.fmu.dll.flexbody_GetStepJacobian
+        f.argtypes = [c_void_p, POINTER(c_uint), c_size_t, POINTER(c_uint), c_size_t, POINTER(c_double)]
+        f.restype = c_int
+        unknowns = (c_uint * len(outputs))(*[self.vr[n] for n in outputs])
+        knowns = (c_uint * len(inputs))(*[self.vr[n] for n in inputs])
+        jacobian = (c_double * (len(outputs) * len(inputs)))()
+        status = f(self.fmu.component, unknowns, len(outputs), knowns, len(inputs), jacobian)
+        if status != 0:
+            raise FMICallException(function="flexbody_GetStepJacobian", status=status)
+        return np.array(jacobian[:], dtype=np.float64).reshape(len(outputs), len(inputs))
 
     def free(self):
         """Terminate (if the instance's state allows it) and free the instance."""

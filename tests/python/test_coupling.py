@@ -55,10 +55,31 @@ def rotation_vector(r: np.ndarray) -> np.ndarray:
     return axial if angle < 1e-12 else axial * angle / np.sin(angle)
 
 
-class CoupledPair:
-    """A and B instantiated, initialized with `parameters` (both) and B's tip load applied."""
+def interface_jacobian(pair, h, start, end):
+    """dr/du of the interface residual `r(u) = u + B.root.load` over the step just evaluated,
+    from the FMUs' step Jacobians (docs/coupling.md, "Jacobians"): A's dynamic compliance
+    (its tip's end pose against the load held over the step) and B's dynamic stiffness (its root
+    load against its frame's velocities, which the secant makes A's end pose over H; its start
+    pose does not depend on `u`)."""
+    j_a = pair.a.step_jacobian(["tip." + n for n in MOTION[:12]], ["tip." + n for n in LOAD])
+    j_b = pair.b.step_jacobian(["root." + n for n in LOAD], ["root." + n for n in MOTION[12:]])
+    r1 = end[3:12].reshape(3, 3)
+    # A change dR1 = [dθ]× R1 of A's end rotation: dθ = axial(dR1 R1ᵀ) per input column; the
+    # secant's rotation vector log(R1 R0ᵀ) moves by J_l⁻¹ dθ, J_l = I to O(ω H) (1e-3 here).
+    dtheta = np.zeros((3, 6))
+    for k in range(6):
+        w = j_a[3:12, k].reshape(3, 3) @ r1.T
+        dtheta[:, k] = 0.5 * np.array([w[2, 1] - w[1, 2], w[0, 2] - w[2, 0], w[1, 0] - w[0, 1]])
+    secant = np.vstack([j_a[:3, :], dtheta]) / h
+    return np.eye(6) + j_b @ secant
 
-    def __init__(self, unzip_a, md_a, unzip_b, md_b, name, parameters):
+
+class CoupledPair:
+    """A and B instantiated, initialized with `parameters` (both) and B's tip load applied.
+    `jacobian`: "differences" (dr/du by differences of repeated steps, once, at the first
+    step) or "fmu" (from the FMUs' step Jacobians at every step)."""
+
+    def __init__(self, unzip_a, md_a, unzip_b, md_b, name, parameters, jacobian="differences"):
         self.a = Instance(unzip_a, md_a, f"A-{name}")
         self.b = Instance(unzip_b, md_b, f"B-{name}")
         self.a_tip_motion = [self.a.vr["tip." + n] for n in MOTION]
@@ -70,7 +91,9 @@ class CoupledPair:
         self.b.initialize({**parameters, "root.position[1]": 1.0})
         self.b.set("tip.force[2]", TIP_LOAD)
         self.jacobian = None
+        self.jacobian_kind = jacobian
         self.evaluations = 0
+        self.jacobian_seconds = 0.0
 
     def read(self, instance, refs) -> np.ndarray:
         return np.array(instance.fmu.getReal(refs))
@@ -100,7 +123,11 @@ class CoupledPair:
         try:
             u = -self.read(self.b, self.b_root_load)  # predictor: the last exchanged load
             r = self._evaluate(t, h, u, start, None)
-            if self.jacobian is None:
+            if self.jacobian_kind == "fmu":
+                started = time.perf_counter()
+                self.jacobian = interface_jacobian(self, h, start, self.read(self.a, self.a_tip_motion))
+                self.jacobian_seconds += time.perf_counter() - started
+            elif self.jacobian is None:
                 # dr/du by forward differences of 1 N (1 N.m): exact for the affine r(u); then
                 # the predictor once more, so that the FMUs are where the iteration starts.
                 self.jacobian = np.column_stack(
