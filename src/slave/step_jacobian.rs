@@ -438,8 +438,19 @@ impl Slave {
             // Fourth-order central differences, (8 (r₊ − r₋) − (r₊₊ − r₋₋)) / 12ε: the
             // frames' rotations make the residual curved enough that the two-point difference
             // at a step above its noise is 4e-6 off (B1's torsion).
-            let epsilon = difference_step(ds, size, h);
             out.fill(0.0);
+            let still = [&ds.position, &ds.velocity, &ds.acceleration]
+                .iter()
+                .all(|v| v.iter().all(|&x| x == 0.0));
+            if still {
+                // Along zero the derivative is zero: only the seed's load (the first linear
+                // iteration of a force seed's first internal step).
+                for (o, f) in out.iter_mut().zip(load) {
+                    *o = -f;
+                }
+                return;
+            }
+            let epsilon = difference_step(ds, size, h);
             for (multiple, weight) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
                 perturb(probe, state, ds, multiple * epsilon);
                 residual(body, free, probe, &loads, forces);
@@ -468,8 +479,8 @@ impl Slave {
             &mut derivative,
             &mut perturbations[j],
             solver,
-        )?;
-        Ok(())
+        )
+        .map(|_| ())
     }
 
     /// Column `j` of the Jacobian: the outputs differentiated (central differences) about the

@@ -31,7 +31,7 @@ use nalgebra::Matrix3;
 /// the largest position perturbation: the derivative is then exact to about that, far below what
 /// a coupling iteration can use, and above the noise of the residual's differences (about 1e-9:
 /// B1's corrections stall at 5e-10 of the perturbation from the third iteration on).
-pub const RELATIVE_TOLERANCE: f64 = 1e-10;
+pub const RELATIVE_TOLERANCE: f64 = 1e-8;
 
 /// A linear iteration whose correction stops shrinking (by half per iteration) below this
 /// fraction of the perturbation has reached the noise of the residual's differences.
