@@ -30,18 +30,22 @@ fn do_step_does_not_allocate_after_the_first_step() {
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.stiffening", 2.0)]);
     pinned_radau_steps_do_not_allocate();
     controlled_steps_do_not_allocate();
-    step_jacobians_do_not_allocate_after_the_first();
+    step_jacobians_do_not_allocate_after_the_first(&[]);
+    // Stiffening on (model.auto off): its K_G is copied into the Jacobian's workspace.
+    step_jacobians_do_not_allocate_after_the_first(&[
+        ("model.auto", 0.0),
+        ("model.stiffening", 2.0),
+    ]);
 }
 
 /// The step Jacobian (`Slave::step_jacobian`) allocates its vectors on its first call; later
 /// calls and the steps between them allocate nothing (a force and a motion interface's seeds,
 /// on the driven cantilever turning at 1 rad/s: its steps allocated the rotation input's name
 /// for an error message until this test).
-fn step_jacobians_do_not_allocate_after_the_first() {
-    let mut s = initialized(
-        example_body("driven_cantilever"),
-        &[("root.angularVelocity[3]", 1.0), ("tip.force[2]", -1.0)],
-    );
+fn step_jacobians_do_not_allocate_after_the_first(extra: &[(&str, f64)]) {
+    let mut settings = vec![("root.angularVelocity[3]", 1.0), ("tip.force[2]", -1.0)];
+    settings.extend_from_slice(extra);
+    let mut s = initialized(example_body("driven_cantilever"), &settings);
     let outputs = [vr(&s, "tip.position[2]"), vr(&s, "root.torque[3]")];
     let inputs = [vr(&s, "tip.force[2]"), vr(&s, "root.angularVelocity[3]")];
     let mut jacobian = [0.0; 4];

@@ -170,14 +170,16 @@ fn about_a_state_at_rest_the_compliance_of_a_force_interface_is_the_step_derivat
 fn under_load_and_with_every_term_the_compliance_is_the_step_derivative() {
     // 10 N on the tip, ringing since t = 0: the internal forces turn with the frames, whose own
     // rotation the Jacobian differentiates through the residual. One frame; five slabs with
-    // f_nl and stiffening (inertial); one internal step per communication step and three (the
+    // f_nl and stiffening (inertial, model.auto off so that it stays on: the enumeration's 2;
+    // 1 is none); one internal step per communication step and three (the
     // step is redone, each internal step linearised about the state it reached).
     let settings: [&[(&str, f64)]; 2] = [
         &[],
         &[
             ("model.frames", 5.0),
             ("model.nonlinearForces", 1.0),
-            ("model.stiffening", 1.0),
+            ("model.stiffening", 2.0),
+            ("model.auto", 0.0),
         ],
     ];
     let deltas = [1.0, 1.0, 1.0, 0.1, 0.1];
@@ -320,14 +322,42 @@ fn what_the_jacobian_does_not_cover_is_refused_by_name() {
     );
     let refused = message(arm.step_jacobian(&[hub], &[torque], &mut j));
     assert!(refused.contains("hinges and rigid sets"), "{refused}");
-    // A failed call changes nothing: the next step is the same as without it.
-    let saved = s.get_state();
-    s.do_step(1e-3, 1e-3).unwrap();
-    let expected = s.get_real(tip).unwrap();
-    s.set_state(&saved).unwrap();
-    let _ = s.step_jacobian(&[tip], &[beta], &mut j);
-    s.do_step(1e-3, 1e-3).unwrap();
-    assert_eq!(s.get_real(tip).unwrap(), expected);
+    // A gravity set after the step is not the step's: the Jacobian redoes the step with the
+    // gravity it was taken with.
+    let mut g = initialized_default(&[("tip.force[2]", -10.0)]);
+    g.do_step(0.0, 1e-3).unwrap();
+    let (mut before, mut after) = ([0.0], [0.0]);
+    g.step_jacobian(&[tip], &[force], &mut before).unwrap();
+    set(&mut g, "gravity[2]", -9810.0);
+    g.step_jacobian(&[tip], &[force], &mut after).unwrap();
+    assert_eq!(before, after);
+    // A call that fails in the redo (an internal step that was retried with halved steps,
+    // which the Jacobian does not follow: at most 2 iterations per step, 10 ms steps under
+    // 10 N, the fixed step so that no finer rung takes the retried step's place) says so and
+    // changes nothing: the run goes on as without it.
+    let settings = [
+        ("tip.force[2]", -10.0),
+        ("solver.maxIterations", 2.0),
+        ("solver.stepSize", 1e-2),
+        ("model.accuracy", 0.0),
+    ];
+    let run = |ask: bool| {
+        let mut s = initialized_default(&settings);
+        let mut tip_y = Vec::new();
+        for k in 0..5 {
+            let retries = s.step_retries();
+            s.do_step(k as f64 * 1e-2, 1e-2).unwrap();
+            if ask && s.step_retries() > retries {
+                let refused = message(s.step_jacobian(&[tip], &[force], &mut [0.0]));
+                assert!(refused.contains("retried its internal step"), "{refused}");
+            }
+            tip_y.push(s.get_real(tip).unwrap());
+        }
+        (tip_y, s.solver_statistics(), s.step_retries())
+    };
+    let (with, without) = (run(true), run(false));
+    assert!(without.2 > 0, "the steps were retried");
+    assert_eq!(with, without);
 }
 
 #[test]

@@ -209,3 +209,46 @@ fn model_accuracy_is_a_parameter_with_its_default_in_the_model_description() {
     let s = Slave::from_body(BodyFile::from_json(&text).unwrap()).unwrap();
     assert_eq!(s.parameters().accuracy, 1e-4);
 }
+
+#[test]
+fn a_step_that_would_not_be_estimated_is_no_probe() {
+    // B1 (default mesh) at the default accuracy, solver.stepSize = H = 1 ms: the control refines
+    // to 0.5 ms after the step load (at 3 ms). From 5 ms the master changes the tip load at
+    // every step, and the ladder is made due for a probe (its calm steps set in the FMU state's
+    // bytes: the payload ends with the rung, the calm steps and the probe's wait as u32, whether
+    // the rung came from a probe as u8, then the deformation scale and the last internal step as
+    // f64). On the rung above, one internal
+    // step after an input jump, nothing would be estimated, so the probe could not be judged:
+    // none is taken, and the step takes its two estimated internal steps of 0.5 ms.
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.set_by_name("solver.stepSize", 1e-3).unwrap();
+    s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
+    s.exit_initialization_mode().unwrap();
+    let force = vr(&s, "tip.force[2]");
+    let h = 1e-3;
+    for k in 0..10 {
+        if k >= 5 {
+            s.set_real(force, -10.0 - 0.01 * k as f64).unwrap();
+        }
+        s.do_step(k as f64 * h, h).unwrap();
+    }
+    assert_eq!(s.controlled_step_size(), 0.5 * h, "the control refined");
+    let mut bytes = Vec::new();
+    flexbody::slave::CoSimSlave::state_to_bytes(&s, &s.get_state(), &mut bytes);
+    let n = bytes.len();
+    let wait = u32::from_le_bytes(bytes[n - 21..n - 17].try_into().unwrap());
+    bytes[n - 25..n - 21].copy_from_slice(&wait.to_le_bytes());
+    let due = s.state_from_bytes(&bytes).unwrap();
+    s.set_state(&due).unwrap();
+    s.set_real(force, -10.2).unwrap();
+    let (steps, _) = s.solver_statistics();
+    s.do_step(10.0 * h, h).unwrap();
+    assert_eq!(
+        s.solver_statistics().0 - steps,
+        2,
+        "the step was taken on the rung above"
+    );
+    assert_eq!(s.controlled_step_size(), 0.5 * h);
+}

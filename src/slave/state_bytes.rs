@@ -15,7 +15,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; deformation scale f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -209,6 +209,7 @@ impl SlaveState {
                 w.u32(d.ladder.level);
                 w.u32(d.ladder.calm_steps);
                 w.u32(d.ladder.probe_after);
+                w.u8(u8::from(d.ladder.probed));
                 w.f64(d.deformation_scale);
                 w.f64(s.step_size);
             }
@@ -392,6 +393,15 @@ impl Slave {
                 }
                 let calm_steps = r.u32("the calm steps on the step level")?;
                 let probe_after = r.u32("the steps the next probe of the step level waits for")?;
+                let probed = match r.u8("whether the step level came from a probe")? {
+                    0 => false,
+                    1 => true,
+                    b => {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state holds {b} for whether the step level came from a probe: not 0 or 1"
+                        )))
+                    }
+                };
                 let probe_range =
                     super::step_control::PROBE_FIRST..=super::step_control::PROBE_LAST;
                 if !probe_range.contains(&probe_after) {
@@ -430,6 +440,7 @@ impl Slave {
                         level: step_level,
                         calm_steps,
                         probe_after,
+                        probed,
                     },
                     deformation_scale,
                 })

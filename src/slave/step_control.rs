@@ -32,8 +32,11 @@
 //! step from 1.67 s on, 16 times the work of whole steps). So after [`PROBE_FIRST`] communication
 //! steps in a row below [`PROBE_BELOW`] on a rung, the next one is taken on the rung above (a
 //! probe): if it stays within its allowance the body keeps the coarser rung, if not it is redone
-//! on its own rung and the next probe waits twice as long (at most [`PROBE_LAST`] steps), which
-//! bounds the cost of probes that fail to a few per cent of the steps.
+//! on its own rung and the next probe waits twice as long (at most [`PROBE_LAST`] steps); a
+//! refinement after a kept probe doubles the wait as well, and only quiet growth (below
+//! [`GROW_BELOW`]) resets it, which bounds the cost of probes that fail to a few per cent of the
+//! steps. A step that would not be estimated (one internal step after an input jump) is not
+//! taken as a probe: a probe is kept on an estimate only.
 
 /// The floor of the allowance in units of the iteration's tolerance `solver.tolerance × size`:
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
@@ -72,6 +75,9 @@ pub struct Ladder {
     pub calm_steps: u32,
     /// How many such steps the next probe waits for ([`PROBE_FIRST`] … [`PROBE_LAST`]).
     pub probe_after: u32,
+    /// Whether this rung was reached by a probe that has not yet been confirmed by as many
+    /// calm steps as the next probe waits for.
+    pub probed: bool,
 }
 
 impl Default for Ladder {
@@ -80,6 +86,7 @@ impl Default for Ladder {
             level: 0,
             calm_steps: 0,
             probe_after: PROBE_FIRST,
+            probed: false,
         }
     }
 }
@@ -90,11 +97,40 @@ impl Ladder {
         self.level > 0 && self.calm_steps >= self.probe_after
     }
 
-    /// On rung `level`, with the memory of a probe cleared (the rung changed).
+    /// On rung `level` after a quiet step moved it up: the scene has become easier, probes start
+    /// over.
     pub fn on(level: u32) -> Ladder {
         Ladder {
             level,
             ..Ladder::default()
+        }
+    }
+
+    /// On rung `level` after a probe from this ladder's rung was kept: the wait for the next
+    /// probe stays as it was.
+    pub fn after_kept_probe(self, level: u32) -> Ladder {
+        Ladder {
+            level,
+            calm_steps: 0,
+            probed: true,
+            ..self
+        }
+    }
+
+    /// On the finer rung `level` after a step was redone on it. If the rung it left had been
+    /// reached by a probe not yet confirmed, that probe was wrong after all: the next waits twice
+    /// as long (a kept probe followed by a refinement does not repeat every few steps).
+    /// Otherwise the scene has become harder and probes start over.
+    pub fn after_refinement(self, level: u32) -> Ladder {
+        if self.probed {
+            Ladder {
+                level,
+                calm_steps: 0,
+                probe_after: (2 * self.probe_after).min(PROBE_LAST),
+                probed: false,
+            }
+        } else {
+            Ladder::on(level)
         }
     }
 
@@ -104,6 +140,7 @@ impl Ladder {
         match ratio {
             Some(r) if r < PROBE_BELOW => Ladder {
                 calm_steps: self.calm_steps.saturating_add(1),
+                probed: self.probed && self.calm_steps + 1 < self.probe_after,
                 ..self
             },
             Some(_) => Ladder {
@@ -169,6 +206,22 @@ mod tests {
         // A ratio at or above PROBE_BELOW starts the count again; no estimate leaves it.
         assert!(!ladder.after_step(Some(PROBE_BELOW)).probes());
         assert!(ladder.after_step(None).probes());
+        // A kept probe keeps the wait; a refinement soon after it doubles the wait, one after the
+        // probe was confirmed by calm steps starts over; quiet growth starts over.
+        let kept = ladder.after_kept_probe(2);
+        assert_eq!(
+            (kept.level, kept.probe_after, kept.calm_steps),
+            (2, PROBE_FIRST, 0)
+        );
+        let refined = kept.after_refinement(3);
+        assert_eq!((refined.level, refined.probe_after), (3, 2 * PROBE_FIRST));
+        let mut confirmed = kept;
+        for _ in 0..PROBE_FIRST {
+            confirmed = confirmed.after_step(Some(0.3));
+        }
+        assert!(!confirmed.probed);
+        assert_eq!(confirmed.after_refinement(3).probe_after, PROBE_FIRST);
+        assert_eq!(Ladder::on(2).probe_after, PROBE_FIRST);
         let mut waits = Vec::new();
         for _ in 0..8 {
             ladder = ladder.after_failed_probe();

@@ -40,13 +40,14 @@ pub(super) struct LastStep {
     pub(super) length: f64,
 }
 
-/// The inputs a communication step was taken with: the inputs, their derivatives and how old
-/// they were at its start (`Slave::input_ages`).
+/// The inputs a communication step was taken with: the inputs, their derivatives, how old
+/// they were at its start (`Slave::input_ages`) and the gravity (a tunable parameter).
 #[derive(Debug, Clone, Default)]
 pub(super) struct StepInputs {
     inputs: Vec<Inputs>,
     derivatives: Vec<super::InputDerivatives>,
     ages: Vec<f64>,
+    gravity: [f64; 3],
 }
 
 impl StepInputs {
@@ -56,7 +57,9 @@ impl StepInputs {
         inputs: &[Inputs],
         derivatives: &[super::InputDerivatives],
         ages: &[f64],
+        gravity: [f64; 3],
     ) {
+        self.gravity = gravity;
         self.inputs.clear();
         self.inputs.extend_from_slice(inputs);
         self.derivatives.clear();
@@ -178,9 +181,10 @@ impl Slave {
             }
             Ok(())
         });
-        // The outputs (and the residual's scratch) of the state as it is.
+        // The outputs (and the residual's scratch) of the state as it is, whatever happened.
         self.outputs.valid = false;
-        result.and_then(|()| self.ensure_outputs())
+        let outputs = self.ensure_outputs();
+        result.and(outputs)
     }
 
     /// The workspace, with a perturbation per input.
@@ -211,9 +215,16 @@ impl Slave {
             }
             ds.time = 0.0;
         }
-        ws.forces
-            .geometric_stiffness
-            .clone_from(&model.forces.geometric_stiffness);
+        // K_G of the step (its pattern is the model's: copy the values, allocate once).
+        match (
+            &mut ws.forces.geometric_stiffness,
+            &model.forces.geometric_stiffness,
+        ) {
+            (Some(to), Some(from)) if to.values.len() == from.values.len() => {
+                to.values.copy_from_slice(&from.values)
+            }
+            (to, from) => *to = from.clone(),
+        }
     }
 
     /// Redoes the last communication step from its start (the backup) with the inputs it was
@@ -240,9 +251,18 @@ impl Slave {
         self.swap_step_inputs();
         let mut result = Ok(());
         for i in 0..last.steps {
+            let retries = self.retries;
             result = self
                 .internal_step(last.start, last.length, i, last.steps, last.step)
                 .and_then(|()| {
+                    if self.retries != retries {
+                        // Its state came from 2, 4 or 8 steps of h/m, each with a factor and a
+                        // change of step of its own: not linearised here.
+                        return Err(Error::new(format!(
+                            "the last fmi2DoStep retried its internal step from t = {} with halved steps, which the step Jacobian does not follow: take a smaller communication step or solver.stepSize",
+                            last.start + i as f64 * last.step
+                        )));
+                    }
                     for (j, &vr) in inputs.iter().enumerate() {
                         let seed = self.jacobian_seed(vr)?;
                         self.linearised_step(seed, j, last.step)?;
@@ -263,8 +283,10 @@ impl Slave {
         result
     }
 
-    /// Exchanges the current inputs with those the last step was taken with (twice: back).
+    /// Exchanges the current inputs and gravity with those the last step was taken with
+    /// (twice: back).
     fn swap_step_inputs(&mut self) {
+        std::mem::swap(&mut self.parameters.gravity, &mut self.step_inputs.gravity);
         std::mem::swap(&mut self.inputs, &mut self.step_inputs.inputs);
         std::mem::swap(
             &mut self.input_derivatives,

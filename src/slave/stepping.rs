@@ -38,13 +38,20 @@ impl Slave {
         let t0 = self.time();
         let controlled = self.error_controlled();
         let ladder = self.dynamics.as_ref().unwrap().ladder;
-        // A probe takes this step on the rung above (step_control, "probes").
-        let mut probing = controlled && ladder.probes();
-        let mut level = ladder.level - u32::from(probing);
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
         self.inputs_jumped = self.update_driving_frames()?;
-        self.step_inputs
-            .copy_from(&self.inputs, &self.input_derivatives, &self.input_ages);
+        // A probe takes this step on the rung above (step_control, "probes"), if the step
+        // there will be estimated (not one internal step after an input jump).
+        let mut probing = controlled
+            && ladder.probes()
+            && (!self.inputs_jumped || self.internal_steps(big_h, ladder.level - 1)?.0 > 1);
+        let mut level = ladder.level - u32::from(probing);
+        self.step_inputs.copy_from(
+            &self.inputs,
+            &self.input_derivatives,
+            &self.input_ages,
+            self.parameters.gravity,
+        );
         // Held inputs that jump at a communication point are not restarted from consistent
         // accelerations (`generalized_alpha::restart_for_load_change`): that makes one FMU's
         // ZOH response second order in h, but it destabilised the iterated coupling of two FMUs
@@ -145,7 +152,7 @@ impl Slave {
                 } else {
                     level
                 };
-                if next != ladder.level && (probing || next < level) {
+                if next != ladder.level && (probing || next < level) && self.step_error.is_some() {
                     self.events.push(LogEvent {
                         category: category::EVENTS,
                         message: format!(
@@ -163,8 +170,15 @@ impl Slave {
                     start: t0,
                     length: big_h,
                 });
-                dynamics.ladder = if next != ladder.level {
+                dynamics.ladder = if probing && self.step_error.is_none() {
+                    // Not estimated after all: back on the rung it probed from.
+                    ladder.after_failed_probe()
+                } else if next < level {
                     Ladder::on(next)
+                } else if probing {
+                    ladder.after_kept_probe(next)
+                } else if next > ladder.level {
+                    ladder.after_refinement(next)
                 } else if failed_probe {
                     ladder.after_failed_probe()
                 } else {
