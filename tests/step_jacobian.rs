@@ -15,6 +15,7 @@
 
 mod common;
 use common::*;
+use flexbody::model::BodyFile;
 use flexbody::slave::{Slave, SlaveState};
 use nalgebra::{Rotation3, Vector3};
 
@@ -313,15 +314,6 @@ fn what_the_jacobian_does_not_cover_is_refused_by_name() {
     radau.do_step(0.0, 1e-3).unwrap();
     let refused = message(radau.step_jacobian(&[tip], &[force], &mut j));
     assert!(refused.contains("solver.integrator"), "{refused}");
-    // Pins, hinges and rigid sets carry multipliers the Jacobian does not propagate yet.
-    let mut arm = initialized(example_body("controlled_arm"), &[]);
-    arm.do_step(0.0, 1e-3).unwrap();
-    let (hub, torque) = (
-        vr(&arm, "hub.angularVelocity[3]"),
-        vr(&arm, "hub.torque[3]"),
-    );
-    let refused = message(arm.step_jacobian(&[hub], &[torque], &mut j));
-    assert!(refused.contains("hinges and rigid sets"), "{refused}");
     // A gravity set after the step is not the step's: the Jacobian redoes the step with the
     // gravity it was taken with.
     let mut g = initialized_default(&[("tip.force[2]", -10.0)]);
@@ -424,4 +416,92 @@ fn the_reduced_body_has_its_step_jacobian_too() {
     let analytic = step_jacobian(&mut s, &pose, &saved, t, 1e-3, &outputs, &inputs);
     let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
     assert!(worst < 2e-5, "reduced driven cantilever: {worst:e}");
+}
+
+#[test]
+fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
+    // The multipliers enter the linearised step through the constrained correction (the point
+    // constraints' C δx, the rigid sets' h'(δx) by differences) and δλ the residual and the
+    // outputs. The controlled arm: a hinge at the root face, a rigid 50 kg hub on it taking the
+    // motor torque; spun up by 100 N m for 0.5 s. And a pinned pendulum swinging under gravity
+    // with a load on its tip. The bearing's moment (its axis lock's multipliers, 1e-4 N m per N
+    // here) is left out: 1.7e-4 of its largest entry off, whatever the differences' steps and the
+    // linear iteration's tolerance, which is not understood yet.
+    let mut arm = initialized(
+        example_body("controlled_arm"),
+        &[
+            ("solver.tolerance", 1e-14),
+            ("model.accuracy", 0.0),
+            ("hub.torque[3]", 100.0),
+        ],
+    );
+    for k in 0..50 {
+        arm.do_step(k as f64 * 1e-2, 1e-2).unwrap();
+    }
+    let (t, saved) = (0.5, arm.get_state());
+    let outputs = [
+        "hub.angularVelocity[3]",
+        "hub.rotation[2]",
+        "tip.position[2]",
+        "tip.velocity[2]",
+        "bearing.force[1]",
+        "bearing.force[2]",
+    ];
+    let inputs = [
+        "hub.torque[3]",
+        "hub.force[2]",
+        "tip.force[2]",
+        "tip.force[3]",
+    ];
+    let deltas = [1.0, 1.0, 1.0, 1.0];
+    let numeric = stepped_differences(
+        &mut arm,
+        &|_| {},
+        &saved,
+        t,
+        1e-2,
+        &outputs,
+        &inputs,
+        &deltas,
+    );
+    let analytic = step_jacobian(&mut arm, &|_| {}, &saved, t, 1e-2, &outputs, &inputs);
+    let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
+    assert!(worst < 2e-5, "controlled arm: {worst:e}");
+    let body = BodyFile::from_json(&pendulum_json(
+        r#"{ "stepSize": 1e-3, "tolerance": 1e-14, "maxIterations": 50 }"#,
+    ))
+    .unwrap();
+    let mut pendulum = initialized(
+        body,
+        &[
+            ("model.accuracy", 0.0),
+            ("gravity[2]", -9.81),
+            ("tip.force[3]", 1.0),
+        ],
+    );
+    for k in 0..100 {
+        pendulum.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+    }
+    let (t, saved) = (0.1, pendulum.get_state());
+    let outputs = [
+        "tip.position[1]",
+        "tip.position[2]",
+        "tip.velocity[3]",
+        "pivot.force[1]",
+        "pivot.force[2]",
+    ];
+    let inputs = ["tip.force[1]", "tip.force[2]", "tip.torque[3]"];
+    let numeric = stepped_differences(
+        &mut pendulum,
+        &|_| {},
+        &saved,
+        t,
+        2e-3,
+        &outputs,
+        &inputs,
+        &[1.0, 1.0, 0.1],
+    );
+    let analytic = step_jacobian(&mut pendulum, &|_| {}, &saved, t, 2e-3, &outputs, &inputs);
+    let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
+    assert!(worst < 2e-5, "pendulum: {worst:e}");
 }

@@ -29,6 +29,8 @@ pub(super) struct JacobianWorkspace {
     /// the iteration matrix turns with) and the perturbed state.
     forces: ResidualWorkspace,
     probe: DynamicState,
+    /// A rigid set's constraint values at a perturbed state.
+    rows: Vec<f64>,
 }
 
 /// The last communication step: `steps` internal steps of `step` from `start` over `length`.
@@ -98,14 +100,15 @@ fn difference_step(ds: &DynamicState, size: f64, step: f64) -> f64 {
     }
 }
 
-/// `state = saved + ε ds` in positions, velocities and accelerations (the multipliers and the
-/// rest as saved).
+/// `state = saved + ε ds` in positions, velocities, accelerations and multipliers (the rest as
+/// saved).
 fn perturb(state: &mut DynamicState, saved: &DynamicState, ds: &DynamicState, epsilon: f64) {
     state.copy_from(saved);
     for (x, d) in [
         (&mut state.position, &ds.position),
         (&mut state.velocity, &ds.velocity),
         (&mut state.acceleration, &ds.acceleration),
+        (&mut state.multipliers, &ds.multipliers),
     ] {
         for (x, d) in x.iter_mut().zip(d.iter()) {
             *x += epsilon * d;
@@ -142,8 +145,8 @@ impl Slave {
     /// `δQ = Q skew(Qᵀ E)` its change makes after the input's orthonormalization); outputs:
     /// any. The state is linearised with the step's own iteration matrix (one solve per input
     /// and internal step) and the outputs are differentiated about the end state; the state is
-    /// left as it was. Generalized-α with the reduced strain only, without pins, hinges or rigid
-    /// sets: otherwise an error saying which. No allocation after the first call.
+    /// left as it was. Generalized-α with the reduced strain only: otherwise an error saying
+    /// which. No allocation after the first call.
     pub fn step_jacobian(
         &mut self,
         outputs: &[u32],
@@ -200,6 +203,7 @@ impl Slave {
             saved_loads: self.inputs.clone(),
             forces: ResidualWorkspace::new(&model.body),
             probe: DynamicState::zeros(n3, multipliers),
+            rows: vec![0.0; multipliers],
         });
         while ws.perturbations.len() < inputs {
             ws.perturbations.push(DynamicState::zeros(n3, multipliers));
@@ -210,6 +214,7 @@ impl Slave {
                 &mut ds.velocity,
                 &mut ds.acceleration,
                 &mut ds.pseudo_acceleration,
+                &mut ds.multipliers,
             ] {
                 v.fill(0.0);
             }
@@ -309,20 +314,6 @@ impl Slave {
                 "the step Jacobian linearises the reduced-strain body; model.formulation = full is not supported",
             ));
         }
-        let free = &self.model.as_ref().expect("a step was taken").free;
-        if !free.constraints.is_empty() || !free.rigid.is_empty() {
-            let names: Vec<&str> = self
-                .body_file
-                .interfaces
-                .iter()
-                .filter(|i| i.rigid || matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge))
-                .map(|i| i.name.as_str())
-                .collect();
-            return Err(Error::new(format!(
-                "the step Jacobian does not cover Lagrange multipliers yet: pins, hinges and rigid sets ({}) are not supported",
-                names.join(", ")
-            )));
-        }
         Ok(())
     }
 
@@ -392,6 +383,7 @@ impl Slave {
             load,
             forces,
             probe,
+            rows,
             ..
         } = model.jacobian.as_mut().unwrap();
         let (body, free) = (&model.body, &model.free);
@@ -456,14 +448,22 @@ impl Slave {
         // The residual's directional derivative at this state, less the seed's load.
         let size = self.size;
         let load = &*load;
-        let mut derivative = |ds: &DynamicState, out: &mut [f64]| {
-            // Fourth-order central differences, (8 (r₊ − r₋) − (r₊₊ − r₋₋)) / 12ε: the
-            // frames' rotations make the residual curved enough that the two-point difference
-            // at a step above its noise is 4e-6 off (B1's torsion).
+        let mut derivative = |ds: &DynamicState, out: &mut [f64], values: &mut [f64]| {
+            // The point constraints' `C δx` (their centroids are linear in x).
+            for (p, c) in free.constraints.iter().enumerate() {
+                values[3 * p..3 * p + 3].copy_from_slice(c.centroid(&ds.position).as_slice());
+            }
+            let points = 3 * free.constraints.len();
+            values[points..].fill(0.0);
             out.fill(0.0);
-            let still = [&ds.position, &ds.velocity, &ds.acceleration]
-                .iter()
-                .all(|v| v.iter().all(|&x| x == 0.0));
+            let still = [
+                &ds.position,
+                &ds.velocity,
+                &ds.acceleration,
+                &ds.multipliers,
+            ]
+            .iter()
+            .all(|v| v.iter().all(|&x| x == 0.0));
             if still {
                 // Along zero the derivative is zero: only the seed's load (the first linear
                 // iteration of a force seed's first internal step).
@@ -472,6 +472,10 @@ impl Slave {
                 }
                 return;
             }
+            // Fourth-order central differences, (8 (r₊ − r₋) − (r₊₊ − r₋₋)) / 12ε, of the
+            // residual and of the rigid sets' constraints: the frames' rotations make the
+            // residual curved enough that the two-point difference at a step above its noise
+            // is 4e-6 off (B1's torsion).
             let epsilon = difference_step(ds, size, h);
             for (multiple, weight) in [(1.0, 8.0), (-1.0, -8.0), (2.0, -1.0), (-2.0, 1.0)] {
                 perturb(probe, state, ds, multiple * epsilon);
@@ -479,6 +483,15 @@ impl Slave {
                 let r = last_residual(forces);
                 for (o, r) in out.iter_mut().zip(r) {
                     *o += weight * r;
+                }
+                let mut row = points;
+                for set in &free.rigid {
+                    let k = set.rows();
+                    set.violation(&probe.position, &mut rows[..k]);
+                    for (v, h) in values[row..row + k].iter_mut().zip(&rows[..k]) {
+                        *v += weight * h / (12.0 * epsilon);
+                    }
+                    row += k;
                 }
             }
             for (o, f) in out.iter_mut().zip(load) {
@@ -494,6 +507,7 @@ impl Slave {
             matrix,
             body,
             free,
+            state,
             &frame,
             &model.forces,
             h,

@@ -405,6 +405,40 @@ impl ConstraintFactor {
         reduced: &mut [f64],
         multipliers: &mut [f64],
     ) {
+        self.correct_towards(constraints, rigid, x, None, r, reduced, multipliers);
+    }
+
+    /// [`Self::correct`] for the step Jacobian's linearised step (docs/formulation.md, "The step
+    /// Jacobian"): the constraints' values are not `C x − d` and `h(x)` but their derivatives
+    /// along the perturbation, `values` (the point constraints' `C δx` in global coordinates, 3
+    /// rows each, then each rigid set's `h'(δx)`), the rigid sets' frames those at `x`; the
+    /// multipliers are the perturbation's `δλ`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn correct_linear(
+        &mut self,
+        constraints: &[PointConstraint],
+        rigid: &[RigidConstraint],
+        x: &[f64],
+        values: &[f64],
+        r: &Matrix3<f64>,
+        reduced: &mut [f64],
+        multipliers: &mut [f64],
+    ) {
+        self.correct_towards(constraints, rigid, x, Some(values), r, reduced, multipliers);
+    }
+
+    /// [`Self::correct`] with the constraints' values `values` given (linear) or taken at `x`.
+    #[allow(clippy::too_many_arguments)]
+    fn correct_towards(
+        &mut self,
+        constraints: &[PointConstraint],
+        rigid: &[RigidConstraint],
+        x: &[f64],
+        values: Option<&[f64]>,
+        r: &Matrix3<f64>,
+        reduced: &mut [f64],
+        multipliers: &mut [f64],
+    ) {
         let n = reduced.len();
         let m = self.error.len();
         // e = C (x + Δx_u) − d, rotated into the frame: hR_cᵀ e = Rᵀ (C x − d) − C y.
@@ -414,7 +448,11 @@ impl ConstraintFactor {
             for (&row, &w) in c.free_rows.iter().zip(&c.weights) {
                 cu += w * Vector3::new(reduced[row], reduced[row + 1], reduced[row + 2]);
             }
-            let e = rt * (c.centroid(x) - c.target) - cu;
+            let value = match values {
+                Some(v) => Vector3::new(v[3 * p], v[3 * p + 1], v[3 * p + 2]),
+                None => c.centroid(x) - c.target,
+            };
+            let e = rt * value - cu;
             self.error[3 * p..3 * p + 3].copy_from_slice(e.as_slice());
         }
         let mut row = 3 * constraints.len();
@@ -422,7 +460,14 @@ impl ConstraintFactor {
             // The linearised error h(x) − Vᵀ hR_sᵀ hR y: y turned from the body's frame into the
             // set's (the matrix's Ā takes the two as one; the error does not need to).
             let k = set.rows();
-            let q = set.violation(x, &mut self.error[row..row + k]).transpose() * r;
+            let frame = match values {
+                Some(v) => {
+                    self.error[row..row + k].copy_from_slice(&v[row..row + k]);
+                    set.rotation(x)
+                }
+                None => set.violation(x, &mut self.error[row..row + k]),
+            };
+            let q = frame.transpose() * r;
             let part = &mut self.set_part[..3 * set.nodes.len()];
             for (local, &fr) in set.free_rows.iter().enumerate() {
                 let turned = q * Vector3::new(reduced[fr], reduced[fr + 1], reduced[fr + 2]);

@@ -41,11 +41,17 @@ pub const NOISE_FLOOR: f64 = 1e-6;
 /// correction or two; slabs: a few).
 pub const MAX_LINEAR_ITERATIONS: usize = 50;
 
+/// `derivative(δs, r', g')`: the residual's directional derivative along `δs` less the seed's
+/// load (full `3N`), and the constraints' (one per multiplier); see [`linear_step`].
+pub type ResidualDerivative<'a> = dyn FnMut(&DynamicState, &mut [f64], &mut [f64]) + 'a;
+
 /// The vectors of [`linear_step`] besides the perturbation itself (allocated once).
 pub struct SensitivityWorkspace {
     previous: DynamicState,
     /// The residual's directional derivative (full `3N`).
     derivative: Vec<f64>,
+    /// The constraints' directional derivatives (one per multiplier).
+    constraint_values: Vec<f64>,
     /// The free rows of `r'` in the nodes' frames, then `S̄⁻¹` of them.
     reduced: Vec<f64>,
 }
@@ -56,6 +62,7 @@ impl SensitivityWorkspace {
         SensitivityWorkspace {
             previous: DynamicState::zeros(n3, free.multiplier_count()),
             derivative: vec![0.0; n3],
+            constraint_values: vec![0.0; free.multiplier_count()],
             reduced: vec![0.0; free.dof_count()],
         }
     }
@@ -64,20 +71,23 @@ impl SensitivityWorkspace {
 /// One internal step of length `h` (with the factor `matrix` of `h`) applied to the perturbation
 /// `ds` (positions, velocities, accelerations, pseudo-accelerations; `ds.time` is the time
 /// since the communication point): `prescribe(τ, ds)` sets the clamped nodes' position
-/// perturbation at the step's end `τ`, `derivative(ds, r')` the residual's directional
-/// derivative along `ds` less the seed's load (full `3N`). `frame` is the body's co-moving frame
-/// and `forces` holds the slabs' frames of the state the step is linearised about (the
-/// iteration matrix's rotations). Returns the linear iterations taken. No allocation.
+/// perturbation at the step's end `τ`, `derivative(ds, r', g')` the residual's directional
+/// derivative along `ds` less the seed's load (full `3N`) and the constraints' (a multiplier's
+/// worth each: the point constraints' `C δx`, the rigid sets' `h'(δx)`). `base` is the state the
+/// step is linearised about, `frame` its co-moving frame; `forces` holds its slabs' frames (the
+/// iteration matrix's rotations). With constraints the correction is the constrained one, and
+/// `ds.multipliers` carries `δλ`. Returns the linear iterations taken. No allocation.
 #[allow(clippy::too_many_arguments)]
 pub fn linear_step(
     matrix: &mut IterationMatrix,
     body: &Body,
     free: &FreeNodes,
+    base: &DynamicState,
     frame: &Matrix3<f64>,
     forces: &ResidualWorkspace,
     h: f64,
     prescribe: &dyn Fn(f64, &mut DynamicState),
-    derivative: &mut dyn FnMut(&DynamicState, &mut [f64]),
+    derivative: &mut ResidualDerivative,
     ds: &mut DynamicState,
     ws: &mut SensitivityWorkspace,
 ) -> Result<usize> {
@@ -92,8 +102,9 @@ pub fn linear_step(
     let c_m = scheme.mass_coefficient(h);
     let c_d = scheme.damping_coefficient(h);
     let mut previous = f64::INFINITY;
+    let mut reach: f64 = 0.0;
     for iteration in 1..=MAX_LINEAR_ITERATIONS {
-        derivative(ds, &mut ws.derivative);
+        derivative(ds, &mut ws.derivative, &mut ws.constraint_values);
         for (k, &i) in free.nodes.iter().enumerate() {
             let r = rotation(i).transpose() * node(&ws.derivative, i);
             set_node(&mut ws.reduced, k, &r);
@@ -101,7 +112,21 @@ pub fn linear_step(
         matrix
             .factor
             .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
-        let scale = ds.position.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        if let Some(constraint) = &mut matrix.constraint {
+            constraint.correct_linear(
+                &free.constraints,
+                &free.rigid,
+                &base.position,
+                &ws.constraint_values,
+                frame,
+                &mut ws.reduced,
+                &mut ds.multipliers,
+            );
+        }
+        // The perturbation's size, or the largest correction so far where the answer is near
+        // zero (a load the constraints take).
+        reach = reach.max(ds.position.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+        let scale = reach;
         let mut largest: f64 = 0.0;
         for (k, &i) in free.nodes.iter().enumerate() {
             let dx = -(rotation(i) * node(&ws.reduced, k));
@@ -118,6 +143,7 @@ pub fn linear_step(
         }
         // Converged, or stalled at the differences' noise within NOISE_FLOOR.
         let stalled = largest > 0.5 * previous && largest <= NOISE_FLOOR * scale;
+        reach = reach.max(largest);
         if largest <= RELATIVE_TOLERANCE * scale || stalled {
             update_pseudo_acceleration(&scheme, free, &ws.previous, ds);
             return Ok(iteration);
