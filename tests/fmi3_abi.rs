@@ -463,3 +463,51 @@ fn start_values_can_be_read_in_instantiated_and_outputs_cannot() {
     assert_eq!(get(c, &[beta], 1), (OK, vec![1e-3]));
     unsafe { fmi3FreeInstance(c) };
 }
+
+/// `flexbody_fmi3GetStepJacobian` (docs/coupling.md, "Jacobians"): over array elements, the
+/// same numbers as the slave's step Jacobian after the same steps (tip.position[3] against
+/// tip.force[3]: a 3 × 3 block); a wrong nJacobian and `time` are refused by name.
+#[test]
+fn the_step_jacobian_through_fmi3_over_array_elements() {
+    let recorder = Recorder::default();
+    let instance = instantiate(&recorder, false);
+    initialize(instance);
+    assert_eq!(set(instance, &[TIP_FORCE], &[0.0, -10.0, 0.0]), OK);
+    steps(instance, 0.0, 1e-3, 5);
+    let mut jacobian = [0.0; 9];
+    let call = |u: &[u32], k: &[u32], j: &mut [f64]| unsafe {
+        flexbody_fmi3GetStepJacobian(
+            instance,
+            u.as_ptr(),
+            u.len(),
+            k.as_ptr(),
+            k.len(),
+            j.as_mut_ptr(),
+            j.len(),
+        )
+    };
+    assert_eq!(call(&[TIP_POSITION], &[TIP_FORCE], &mut jacobian), OK);
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.exit_initialization_mode().unwrap();
+    s.set_real(TIP_FORCE + 1, -10.0).unwrap();
+    for k in 0..5 {
+        s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+    }
+    let rows = [TIP_POSITION, TIP_POSITION + 1, TIP_POSITION + 2];
+    let columns = [TIP_FORCE, TIP_FORCE + 1, TIP_FORCE + 2];
+    let mut expected = [0.0; 9];
+    s.step_jacobian(&rows, &columns, &mut expected).unwrap();
+    assert_eq!(jacobian, expected);
+    assert!(jacobian[4] > 0.0, "a force along y moves the tip along y");
+    assert_eq!(call(&[TIP_POSITION], &[TIP_FORCE], &mut jacobian[..8]), ERR);
+    assert!(
+        recorder.last().contains("nJacobian = 8"),
+        "{}",
+        recorder.last()
+    );
+    assert_eq!(call(&[0], &[TIP_FORCE], &mut jacobian[..3]), ERR);
+    assert!(recorder.last().contains("time"), "{}", recorder.last());
+    unsafe { fmi3FreeInstance(instance) };
+}

@@ -73,6 +73,8 @@ pub struct Fmi3Instance {
     /// Integer and Boolean values of the current request.
     integers: Vec<i32>,
     flags: Vec<bool>,
+    /// The scalar value references of the knowns of a step Jacobian request.
+    knowns: Vec<u32>,
 }
 
 /// The marker for `time` among the scalar value references of a request.
@@ -102,6 +104,7 @@ impl Fmi3Instance {
             orders: Vec::new(),
             integers: Vec::new(),
             flags: Vec::new(),
+            knowns: Vec::new(),
         }
     }
 
@@ -352,6 +355,50 @@ impl Fmi3Instance {
         }
         self.inner
             .get_real_output_derivatives(&self.scalars, &self.orders, values)
+    }
+
+    /// `flexbody_fmi3GetStepJacobian`: the step Jacobian of the last `fmi3DoStep`
+    /// ([`crate::fmi2::Instance::step_jacobian`]) over the elements of the array variables
+    /// `unknowns` (rows) and `knowns` (columns), each array's elements in row-major order;
+    /// `jacobian` has one entry per pair of elements.
+    pub fn step_jacobian(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        jacobian: &mut [f64],
+    ) -> fmi2Status {
+        const F: &str = "flexbody_fmi3GetStepJacobian";
+        let elements = |vrs: &[u32]| -> usize {
+            vrs.iter()
+                .map(|vr| self.arrays.get(vr).map_or(1, |a| a.len))
+                .sum()
+        };
+        let (rows, columns) = (elements(unknowns), elements(knowns));
+        if rows * columns != jacobian.len() {
+            return self.fail(
+                F,
+                &format!(
+                    "nJacobian = {} rejected: the unknowns have {rows} elements and the knowns {columns}",
+                    jacobian.len()
+                ),
+            );
+        }
+        if let Err(s) = self.expand(F, Fmi3Type::Float64, knowns, columns) {
+            return s;
+        }
+        std::mem::swap(&mut self.knowns, &mut self.scalars);
+        let status = match self.expand(F, Fmi3Type::Float64, unknowns, rows) {
+            Err(s) => s,
+            Ok(()) if self.scalars.contains(&TIME) || self.knowns.contains(&TIME) => self.fail(
+                F,
+                "time (value reference 0) is neither an output nor an input",
+            ),
+            Ok(()) => self
+                .inner
+                .step_jacobian(F, &self.scalars, &self.knowns, jacobian),
+        };
+        std::mem::swap(&mut self.knowns, &mut self.scalars);
+        status
     }
 
     /// `fmi3EnterInitializationMode`: FMI 2.0's `fmi2SetupExperiment` and

@@ -57,7 +57,7 @@ pub unsafe extern "C" fn flexbody_GetStepJacobian(
             size.and_then(|n| slice_out(jacobian, n)),
         ) {
             (Some(unknowns), Some(knowns), Some(values)) => {
-                inst.step_jacobian(unknowns, knowns, values)
+                inst.step_jacobian(F, unknowns, knowns, values)
             }
             _ => inst.fail(
                 F,

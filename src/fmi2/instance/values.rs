@@ -362,12 +362,13 @@ impl<S: CoSimSlave> Instance<S> {
     /// Jacobian covers. On error the instance is as it was (`jacobian`'s entries unspecified).
     pub fn step_jacobian(
         &mut self,
+        function: &str,
         unknowns: &[u32],
         knowns: &[u32],
         jacobian: &mut [f64],
     ) -> fmi2Status {
-        const F: &str = "flexbody_GetStepJacobian";
-        if let Err(s) = self.check_state(F, DO_STEP) {
+        let f = function;
+        if let Err(s) = self.check_state(f, DO_STEP) {
             return s;
         }
         for (&vr, causality, role) in unknowns
@@ -387,15 +388,15 @@ impl<S: CoSimSlave> Instance<S> {
                 Err(e) => Some(e),
             };
             if let Some(reason) = reason {
-                return self.fail(F, &reason);
+                return self.fail(f, &reason);
             }
         }
         let result = self.slave.step_jacobian(unknowns, knowns, jacobian);
         self.flush_events();
         match result {
             Ok(()) if jacobian.iter().all(|x| x.is_finite()) => fmi2Status::fmi2OK,
-            Ok(()) => self.fail(F, "the step Jacobian is not finite"),
-            Err(e) => self.report(F, &e),
+            Ok(()) => self.fail(f, "the step Jacobian is not finite"),
+            Err(e) => self.report(f, &e),
         }
     }
 }

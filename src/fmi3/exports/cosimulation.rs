@@ -80,3 +80,35 @@ pub unsafe extern "C" fn fmi3GetOutputDerivatives(
         }
     })
 }
+
+/// `flexbody_fmi3GetStepJacobian` (not an FMI function; docs/coupling.md, "Jacobians"): the
+/// step Jacobian of the last `fmi3DoStep` for an FMI 3.0 importer, over the elements of the
+/// array variables `unknowns` (Float64 outputs, rows) and `knowns` (Float64 inputs, columns),
+/// each array's elements in row-major order: `jacobian` (row-major, `nJacobian` = the product
+/// of the two element counts). The FMI 2.0 function `flexbody_GetStepJacobian` says why it is
+/// not `fmi3GetDirectionalDerivative`.
+#[no_mangle]
+pub unsafe extern "C" fn flexbody_fmi3GetStepJacobian(
+    instance: fmi3Instance,
+    unknowns: *const fmi3ValueReference,
+    nUnknowns: usize,
+    knowns: *const fmi3ValueReference,
+    nKnowns: usize,
+    jacobian: *mut fmi3Float64,
+    nJacobian: usize,
+) -> fmi3Status {
+    const F: &str = "flexbody_fmi3GetStepJacobian";
+    call(instance, F, |inst| {
+        match (
+            slice_in(unknowns, nUnknowns),
+            slice_in(knowns, nKnowns),
+            slice_out(jacobian, nJacobian),
+        ) {
+            (Some(u), Some(k), Some(j)) => inst.step_jacobian(u, k, j),
+            _ => inst.fail(
+                F,
+                &format!("unknowns, knowns or jacobian is NULL with nUnknowns = {nUnknowns}, nKnowns = {nKnowns}, nJacobian = {nJacobian}"),
+            ),
+        }
+    })
+}
