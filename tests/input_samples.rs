@@ -9,6 +9,30 @@ use common::b3::HubDrive;
 use common::*;
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
+/// B3 with `settings` for `steps` communication steps of 10 ms, once whole and once as two
+/// half steps per input update: per update, `each(slave split in halves, its tip deflection,
+/// the whole-step tip deflection, the time)`; the two slaves at the end (whole, split).
+fn whole_and_split(
+    settings: &[(&str, f64)],
+    steps: usize,
+    mut each: impl FnMut(&mut flexbody::slave::Slave, f64, f64, f64),
+) -> (flexbody::slave::Slave, flexbody::slave::Slave) {
+    let mut whole = initialized(example_body("hub_beam"), settings);
+    let mut split = initialized(example_body("hub_beam"), settings);
+    let drive = HubDrive::new(&whole);
+    let big_h = 1e-2;
+    for k in 0..steps {
+        let t = k as f64 * big_h;
+        let y_whole = drive.step(&mut whole, t, big_h).unwrap();
+        drive.set_hub(&mut split, t).unwrap();
+        split.do_step(t, 0.5 * big_h).unwrap();
+        split.do_step(t + 0.5 * big_h, 0.5 * big_h).unwrap();
+        let y_split = drive.tip_deflection(&mut split, t + big_h).unwrap();
+        each(&mut split, y_split, y_whole, t);
+    }
+    (whole, split)
+}
+
 /// B3 spun up for 8 s (the peak of the lag is at about 7 s) with the hub inputs set once per
 /// H = 0.01 s: once with one step of H per update, once with two steps of H/2 per update. The
 /// internal step is H/2 in both runs (solver.stepSize = 0.005), so both solve the same discrete
@@ -22,21 +46,11 @@ fn b3_with_two_steps_per_input_update_follows_b3_with_one() {
     // One model throughout (model.accuracy = 0: no error control and no model.auto slabs, whose
     // switch would fall on different communication points in the two runs).
     let settings = [("solver.stepSize", 5e-3), ("model.accuracy", 0.0)];
-    let mut whole = initialized(example_body("hub_beam"), &settings);
-    let mut split = initialized(example_body("hub_beam"), &settings);
-    let drive = HubDrive::new(&whole);
-    let big_h = 1e-2;
     let (mut worst, mut peak) = (0.0_f64, 0.0_f64);
-    for k in 0..800 {
-        let t = k as f64 * big_h;
-        let y_whole = drive.step(&mut whole, t, big_h).unwrap();
-        drive.set_hub(&mut split, t).unwrap();
-        split.do_step(t, 0.5 * big_h).unwrap();
-        split.do_step(t + 0.5 * big_h, 0.5 * big_h).unwrap();
-        let y_split = drive.tip_deflection(&mut split, t + big_h).unwrap();
+    whole_and_split(&settings, 800, |_, y_split, y_whole, _| {
         worst = worst.max((y_split - y_whole).abs());
         peak = peak.max(y_whole.abs());
-    }
+    });
     println!("peak {peak:.4} m, largest difference {worst:.3e} m");
     assert!(peak > 0.3, "the spin-up bends the beam: peak {peak} m");
     assert!(
@@ -170,18 +184,8 @@ fn the_sample_times_are_part_of_the_fmu_state() {
 #[test]
 fn an_importer_that_splits_steps_does_not_trap_the_error_control_on_a_fine_rung() {
     let settings = [("model.accuracy", 1e-3)];
-    let mut whole = initialized(example_body("hub_beam"), &settings);
-    let mut split = initialized(example_body("hub_beam"), &settings);
-    let drive = HubDrive::new(&whole);
-    let big_h = 1e-2;
     let (mut worst, mut finest, mut climbs) = (0.0_f64, f64::INFINITY, Vec::new());
-    for k in 0..300 {
-        let t = k as f64 * big_h;
-        let y_whole = drive.step(&mut whole, t, big_h).unwrap();
-        drive.set_hub(&mut split, t).unwrap();
-        split.do_step(t, 0.5 * big_h).unwrap();
-        split.do_step(t + 0.5 * big_h, 0.5 * big_h).unwrap();
-        let y_split = drive.tip_deflection(&mut split, t + big_h).unwrap();
+    let (whole, split) = whole_and_split(&settings, 300, |split, y_split, y_whole, t| {
         worst = worst.max((y_split - y_whole).abs());
         finest = finest.min(split.controlled_step_size());
         let rung = split.controlled_step_size();
@@ -191,7 +195,7 @@ fn an_importer_that_splits_steps_does_not_trap_the_error_control_on_a_fine_rung(
         {
             climbs.push((t, rung));
         }
-    }
+    });
     let end = split.controlled_step_size();
     println!(
         "finest rung {finest:e} s, at 3 s {end:e} s; probes that climbed: {climbs:?}; internal steps split {}, whole {}; largest difference {worst:.3e} m",

@@ -72,6 +72,41 @@ fn step_jacobian(
     jacobian
 }
 
+/// From `saved` at `t`, the step `big_h` with no inputs of the master's: the Jacobian of
+/// `outputs` against `inputs` and the repeated steps' differences (changes `deltas`), compared
+/// by [`worst_relative_difference`].
+#[allow(clippy::too_many_arguments)]
+fn compared_from(
+    s: &mut Slave,
+    saved: &SlaveState,
+    t: f64,
+    big_h: f64,
+    outputs: &[&str],
+    inputs: &[&str],
+    deltas: &[f64],
+) -> f64 {
+    let numeric = stepped_differences(s, &|_| {}, saved, t, big_h, outputs, inputs, deltas);
+    let analytic = step_jacobian(s, &|_| {}, saved, t, big_h, outputs, inputs);
+    worst_relative_difference(outputs, inputs.len(), &analytic, &numeric)
+}
+
+/// [`compared_from`] after `steps` steps of `h` from `s`'s start.
+fn compared_after(
+    s: &mut Slave,
+    steps: usize,
+    h: f64,
+    big_h: f64,
+    outputs: &[&str],
+    inputs: &[&str],
+    deltas: &[f64],
+) -> f64 {
+    for k in 0..steps {
+        s.do_step(k as f64 * h, h).unwrap();
+    }
+    let (t, saved) = (s.time(), s.get_state());
+    compared_from(s, &saved, t, big_h, outputs, inputs, deltas)
+}
+
 /// The largest difference between `a` and `b` over the rows of each output quantity (the
 /// name before `[`), relative to the largest entry of those rows; per quantity, printed.
 fn worst_relative_difference(outputs: &[&str], columns: usize, a: &[f64], b: &[f64]) -> f64 {
@@ -151,18 +186,7 @@ fn about_a_state_at_rest_the_compliance_of_a_force_interface_is_the_step_derivat
     let deltas = [1.0, 1.0, 1.0, 0.1, 0.1];
     for big_h in [1e-3, 4e-3] {
         // One internal step, and four (solver.stepSize = 1 ms).
-        let numeric = stepped_differences(
-            &mut s,
-            &|_| {},
-            &saved,
-            t,
-            big_h,
-            &TIP_OUTPUTS,
-            &TIP_INPUTS,
-            &deltas,
-        );
-        let analytic = step_jacobian(&mut s, &|_| {}, &saved, t, big_h, &TIP_OUTPUTS, &TIP_INPUTS);
-        let worst = worst_relative_difference(&TIP_OUTPUTS, TIP_INPUTS.len(), &analytic, &numeric);
+        let worst = compared_from(&mut s, &saved, t, big_h, &TIP_OUTPUTS, &TIP_INPUTS, &deltas);
         assert!(worst < 2e-5, "H = {big_h}: {worst:e}");
     }
 }
@@ -187,20 +211,7 @@ fn under_load_and_with_every_term_the_compliance_is_the_step_derivative() {
     for extra in settings {
         for big_h in [1e-3, 3e-3] {
             let (mut s, saved, t) = b1_after(-10.0, extra);
-            let numeric = stepped_differences(
-                &mut s,
-                &|_| {},
-                &saved,
-                t,
-                big_h,
-                &TIP_OUTPUTS,
-                &TIP_INPUTS,
-                &deltas,
-            );
-            let analytic =
-                step_jacobian(&mut s, &|_| {}, &saved, t, big_h, &TIP_OUTPUTS, &TIP_INPUTS);
-            let worst =
-                worst_relative_difference(&TIP_OUTPUTS, TIP_INPUTS.len(), &analytic, &numeric);
+            let worst = compared_from(&mut s, &saved, t, big_h, &TIP_OUTPUTS, &TIP_INPUTS, &deltas);
             assert!(worst < 2e-5, "{extra:?}, H = {big_h}: {worst:e}");
         }
     }
@@ -435,10 +446,6 @@ fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
             ("hub.torque[3]", 100.0),
         ],
     );
-    for k in 0..50 {
-        arm.do_step(k as f64 * 1e-2, 1e-2).unwrap();
-    }
-    let (t, saved) = (0.5, arm.get_state());
     let outputs = [
         "hub.angularVelocity[3]",
         "hub.rotation[2]",
@@ -453,19 +460,7 @@ fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
         "tip.force[2]",
         "tip.force[3]",
     ];
-    let deltas = [1.0, 1.0, 1.0, 1.0];
-    let numeric = stepped_differences(
-        &mut arm,
-        &|_| {},
-        &saved,
-        t,
-        1e-2,
-        &outputs,
-        &inputs,
-        &deltas,
-    );
-    let analytic = step_jacobian(&mut arm, &|_| {}, &saved, t, 1e-2, &outputs, &inputs);
-    let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
+    let worst = compared_after(&mut arm, 50, 1e-2, 1e-2, &outputs, &inputs, &[1.0; 4]);
     assert!(worst < 2e-5, "controlled arm: {worst:e}");
     let body = BodyFile::from_json(&pendulum_json(
         r#"{ "stepSize": 1e-3, "tolerance": 1e-14, "maxIterations": 50 }"#,
@@ -479,10 +474,6 @@ fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
             ("tip.force[3]", 1.0),
         ],
     );
-    for k in 0..100 {
-        pendulum.do_step(k as f64 * 1e-3, 1e-3).unwrap();
-    }
-    let (t, saved) = (0.1, pendulum.get_state());
     let outputs = [
         "tip.position[1]",
         "tip.position[2]",
@@ -491,17 +482,14 @@ fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
         "pivot.force[2]",
     ];
     let inputs = ["tip.force[1]", "tip.force[2]", "tip.torque[3]"];
-    let numeric = stepped_differences(
+    let worst = compared_after(
         &mut pendulum,
-        &|_| {},
-        &saved,
-        t,
+        100,
+        1e-3,
         2e-3,
         &outputs,
         &inputs,
         &[1.0, 1.0, 0.1],
     );
-    let analytic = step_jacobian(&mut pendulum, &|_| {}, &saved, t, 2e-3, &outputs, &inputs);
-    let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
     assert!(worst < 2e-5, "pendulum: {worst:e}");
 }

@@ -151,7 +151,7 @@ fn test_task(args: &[String]) -> Result<()> {
     let imports = fmu::check_windows_imports(&dll)?;
     let exports = fmu::check_windows_exports(&dll, &fmu::build_release(&workspace)?.library)?;
     println!(
-        "xtask test: the win64 DLL exports the {exports} fmi2 and fmi3 functions of the linux64 library, unmangled, and imports only Windows' own DLLs: {}",
+        "xtask test: the win64 DLL exports the {exports} fmi2, fmi3 and flexbody_ functions of the linux64 library, unmangled, and imports only Windows' own DLLs: {}",
         imports.join(", ")
     );
     // The other release builds are no-ops: only the packaging differs.
