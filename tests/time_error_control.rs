@@ -238,8 +238,8 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     let mut bytes = Vec::new();
     flexbody::slave::CoSimSlave::state_to_bytes(&s, &s.get_state(), &mut bytes);
     let n = bytes.len();
-    let wait = u32::from_le_bytes(bytes[n - 21..n - 17].try_into().unwrap());
-    bytes[n - 25..n - 21].copy_from_slice(&wait.to_le_bytes());
+    let wait = u32::from_le_bytes(bytes[n - 33..n - 29].try_into().unwrap());
+    bytes[n - 37..n - 33].copy_from_slice(&wait.to_le_bytes());
     let due = s.state_from_bytes(&bytes).unwrap();
     s.set_state(&due).unwrap();
     s.set_real(force, -10.2).unwrap();

@@ -62,6 +62,7 @@ impl Slave {
             pseudo_acceleration: vec![0.0; 3 * n],
             multipliers: vec![0.0; model.free.multiplier_count()],
             step_size: 0.0,
+            iteration: Default::default(),
         };
         body.place_rigidly(
             &placement.origin,

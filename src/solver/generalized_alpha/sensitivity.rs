@@ -76,7 +76,10 @@ impl SensitivityWorkspace {
 /// worth each: the point constraints' `C δx`, the rigid sets' `h'(δx)`). `base` is the state the
 /// step is linearised about, `frame` its co-moving frame; `forces` holds its slabs' frames (the
 /// iteration matrix's rotations). With constraints the correction is the constrained one, and
-/// `ds.multipliers` carries `δλ`. Returns the linear iterations taken. No allocation.
+/// `ds.multipliers` carries `δλ`. `single`: the step stopped after its first correction
+/// (`generalized_alpha::one_iteration_enough`, or a predictor within the tolerance), so its map
+/// is the predictor and one correction, and so is this one's. Returns the linear iterations
+/// taken. No allocation.
 #[allow(clippy::too_many_arguments)]
 pub fn linear_step(
     matrix: &mut IterationMatrix,
@@ -88,6 +91,7 @@ pub fn linear_step(
     h: f64,
     prescribe: &dyn Fn(f64, &mut DynamicState),
     derivative: &mut ResidualDerivative,
+    single: bool,
     ds: &mut DynamicState,
     ws: &mut SensitivityWorkspace,
 ) -> Result<usize> {
@@ -144,7 +148,7 @@ pub fn linear_step(
         // Converged, or stalled at the differences' noise within NOISE_FLOOR.
         let stalled = largest > 0.5 * previous && largest <= NOISE_FLOOR * scale;
         reach = reach.max(largest);
-        if largest <= RELATIVE_TOLERANCE * scale || stalled {
+        if single || largest <= RELATIVE_TOLERANCE * scale || stalled {
             update_pseudo_acceleration(&scheme, free, &ws.previous, ds);
             return Ok(iteration);
         }
