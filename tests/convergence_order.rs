@@ -96,7 +96,6 @@ fn initial_state(c: &Cantilever) -> DynamicState {
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
         step_size: 0.0,
-        iteration: Default::default(),
     }
 }
 

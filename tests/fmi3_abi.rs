@@ -509,5 +509,45 @@ fn the_step_jacobian_through_fmi3_over_array_elements() {
     );
     assert_eq!(call(&[0], &[TIP_FORCE], &mut jacobian[..3]), ERR);
     assert!(recorder.last().contains("time"), "{}", recorder.last());
+    // Several arrays, a [3,3] one among them: rows tip.position then tip.rotation (12),
+    // columns tip.force then tip.torque (6), each array's elements in row-major order.
+    let (tip_rotation, tip_torque) = (TIP_POSITION + 3, TIP_FORCE + 3);
+    let mut big = [0.0; 72];
+    assert_eq!(
+        call(
+            &[TIP_POSITION, tip_rotation],
+            &[TIP_FORCE, tip_torque],
+            &mut big
+        ),
+        OK
+    );
+    let rows: Vec<u32> = (TIP_POSITION..TIP_POSITION + 12).collect();
+    let columns: Vec<u32> = (TIP_FORCE..TIP_FORCE + 6).collect();
+    let mut expected = [0.0; 72];
+    s.step_jacobian(&rows, &columns, &mut expected).unwrap();
+    assert_eq!(big, expected);
+    // An unknown value reference is named (before the sizes are checked).
+    assert_eq!(call(&[9999], &[TIP_FORCE], &mut jacobian[..3]), ERR);
+    assert!(recorder.last().contains("9999"), "{}", recorder.last());
     unsafe { fmi3FreeInstance(instance) };
+    // Before a step: the calling sequence.
+    let fresh = instantiate(&recorder, false);
+    let status = unsafe {
+        flexbody_fmi3GetStepJacobian(
+            fresh,
+            [TIP_POSITION].as_ptr(),
+            1,
+            [TIP_FORCE].as_ptr(),
+            1,
+            jacobian.as_mut_ptr(),
+            9,
+        )
+    };
+    assert_eq!(status, ERR);
+    assert!(
+        recorder.last().contains("flexbody_fmi3GetStepJacobian"),
+        "{}",
+        recorder.last()
+    );
+    unsafe { fmi3FreeInstance(fresh) };
 }

@@ -84,7 +84,6 @@ fn run_from(
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
         step_size: 0.0,
-        iteration: Default::default(),
     };
     let loads = |t: f64, _x: &[f64], out: &mut [f64]| {
         if !pulse {

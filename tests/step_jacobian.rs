@@ -436,8 +436,9 @@ fn pins_hinges_and_rigid_sets_have_their_step_jacobian() {
     // outputs. The controlled arm: a hinge at the root face, a rigid 50 kg hub on it taking the
     // motor torque; spun up by 100 N m for 0.5 s. And a pinned pendulum swinging under gravity
     // with a load on its tip. The bearing's moment (its axis lock's multipliers, 1e-4 N m per N
-    // here) is left out: 1.7e-4 of its largest entry off, whatever the differences' steps and the
-    // linear iteration's tolerance, which is not understood yet.
+    // here) is left out: 1.7e-4 of its largest entry off, whatever the differences' steps, the
+    // linear iteration's tolerance and whether it waits for the multipliers to settle, which is
+    // not understood yet.
     let mut arm = initialized(
         example_body("controlled_arm"),
         &[

@@ -237,9 +237,13 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     assert_eq!(s.controlled_step_size(), 0.5 * h, "the control refined");
     let mut bytes = Vec::new();
     flexbody::slave::CoSimSlave::state_to_bytes(&s, &s.get_state(), &mut bytes);
-    let n = bytes.len();
-    let wait = u32::from_le_bytes(bytes[n - 33..n - 29].try_into().unwrap());
-    bytes[n - 37..n - 33].copy_from_slice(&wait.to_le_bytes());
+    // From the payload's end (src/slave/state_bytes.rs): the last internal step and the
+    // deformation scale (f64 each), whether the rung came from a probe (u8), the probe's wait
+    // and before it the calm steps (u32 each).
+    let wait_at = bytes.len() - 8 - 8 - 1 - 4;
+    let calm_at = wait_at - 4;
+    let wait = u32::from_le_bytes(bytes[wait_at..wait_at + 4].try_into().unwrap());
+    bytes[calm_at..calm_at + 4].copy_from_slice(&wait.to_le_bytes());
     let due = s.state_from_bytes(&bytes).unwrap();
     s.set_state(&due).unwrap();
     s.set_real(force, -10.2).unwrap();

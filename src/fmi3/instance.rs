@@ -374,25 +374,23 @@ impl Fmi3Instance {
                 .sum()
         };
         let (rows, columns) = (elements(unknowns), elements(knowns));
-        if rows * columns != jacobian.len() {
-            return self.fail(
-                F,
-                &format!(
-                    "nJacobian = {} rejected: the unknowns have {rows} elements and the knowns {columns}",
-                    jacobian.len()
-                ),
-            );
-        }
+        // The value references first (an unknown one is named), then the size.
         if let Err(s) = self.expand(F, Fmi3Type::Float64, knowns, columns) {
             return s;
         }
         std::mem::swap(&mut self.knowns, &mut self.scalars);
         let status = match self.expand(F, Fmi3Type::Float64, unknowns, rows) {
             Err(s) => s,
-            Ok(()) if self.scalars.contains(&TIME) || self.knowns.contains(&TIME) => self.fail(
+            Ok(()) if rows * columns != jacobian.len() => self.fail(
                 F,
-                "time (value reference 0) is neither an output nor an input",
+                &format!(
+                    "nJacobian = {} rejected: the unknowns have {rows} elements and the knowns {columns}",
+                    jacobian.len()
+                ),
             ),
+            Ok(()) if self.scalars.contains(&TIME) || self.knowns.contains(&TIME) => {
+                self.fail(F, "time (value reference 0) is neither an output nor an input")
+            }
             Ok(()) => self
                 .inner
                 .step_jacobian(F, &self.scalars, &self.knowns, jacobian),

@@ -62,7 +62,6 @@ impl Slave {
             pseudo_acceleration: vec![0.0; 3 * n],
             multipliers: vec![0.0; model.free.multiplier_count()],
             step_size: 0.0,
-            iteration: Default::default(),
         };
         body.place_rigidly(
             &placement.origin,

@@ -15,7 +15,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the last internal step's length f64 (0: none); the iteration's first contraction f64 (1: not known), steps of one iteration since u32 |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -212,8 +212,6 @@ impl SlaveState {
                 w.u8(u8::from(d.ladder.probed));
                 w.f64(d.deformation_scale);
                 w.f64(s.step_size);
-                w.f64(s.iteration.first_contraction);
-                w.u32(s.iteration.single_steps);
             }
         }
     }
@@ -423,13 +421,6 @@ impl Slave {
                         "the serialized FMU state holds {step_size} for the last internal step's length: not finite and at least 0"
                     )));
                 }
-                let first_contraction = r.f64("the iteration's first contraction")?;
-                if !(0.0..=1.0).contains(&first_contraction) {
-                    return Err(Error::new(format!(
-                        "the serialized FMU state holds {first_contraction} for the iteration's first contraction: not within 0 to 1"
-                    )));
-                }
-                let single_steps = r.u32("the steps of one iteration since the contraction")?;
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -440,10 +431,6 @@ impl Slave {
                         pseudo_acceleration,
                         multipliers: lambda,
                         step_size,
-                        iteration: crate::solver::problem::IterationHistory {
-                            first_contraction,
-                            single_steps,
-                        },
                     },
                     loads,
                     gravity,

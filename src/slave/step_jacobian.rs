@@ -257,7 +257,6 @@ impl Slave {
         let mut result = Ok(());
         for i in 0..last.steps {
             let retries = self.retries;
-            let singles = self.dynamics.as_ref().unwrap().state.iteration.single_steps;
             result = self
                 .internal_step(last.start, last.length, i, last.steps, last.step)
                 .and_then(|()| {
@@ -269,12 +268,9 @@ impl Slave {
                             last.start + i as f64 * last.step
                         )));
                     }
-                    // Stopped after its first correction: the same map for the perturbation.
-                    let after = self.dynamics.as_ref().unwrap().state.iteration.single_steps;
-                    let single = after == singles.saturating_add(1);
                     for (j, &vr) in inputs.iter().enumerate() {
                         let seed = self.jacobian_seed(vr)?;
-                        self.linearised_step(seed, j, last.step, single)?;
+                        self.linearised_step(seed, j, last.step)?;
                     }
                     Ok(())
                 });
@@ -377,9 +373,8 @@ impl Slave {
     }
 
     /// Input `j`'s perturbation (seed `seed`) carried through one internal step of `h`,
-    /// linearised about the state it reached (the current one); `single`: that step stopped
-    /// after one iteration.
-    fn linearised_step(&mut self, seed: Seed, j: usize, h: f64, single: bool) -> Result<()> {
+    /// linearised about the state it reached (the current one).
+    fn linearised_step(&mut self, seed: Seed, j: usize, h: f64) -> Result<()> {
         let start = self.jacobian_step.map_or(0.0, |l| l.start);
         let model = self.model.as_mut().unwrap();
         let JacobianWorkspace {
@@ -518,7 +513,6 @@ impl Slave {
             h,
             &prescribe,
             &mut derivative,
-            single,
             &mut perturbations[j],
             solver,
         )

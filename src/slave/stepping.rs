@@ -173,14 +173,19 @@ impl Slave {
                 dynamics.ladder = if probing && self.step_error.is_none() {
                     // Not estimated after all: back on the rung it probed from.
                     ladder.after_failed_probe()
+                } else if failed_probe && next <= ladder.level {
+                    // A failed probe's redo stays on its rung, even if quiet: the rung above has
+                    // just failed.
+                    Ladder {
+                        level: ladder.level,
+                        ..ladder.after_failed_probe()
+                    }
                 } else if next < level {
                     Ladder::on(next)
                 } else if probing {
                     ladder.after_kept_probe(next)
                 } else if next > ladder.level {
                     ladder.after_refinement(next)
-                } else if failed_probe {
-                    ladder.after_failed_probe()
                 } else {
                     ladder.after_step(self.step_error)
                 };

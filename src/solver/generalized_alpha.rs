@@ -22,8 +22,8 @@ use super::anderson::{Anderson, DEFAULT_DEPTH};
 use super::constraints::ConstraintFactor;
 use super::fixed_point::{largest_correction, mix_update, Convergence};
 use super::problem::{
-    residual, DynamicState, FreeNodes, IterationHistory, IterationSettings, ResidualWorkspace,
-    StepProblem, StepReport,
+    residual, DynamicState, FreeNodes, IterationSettings, ResidualWorkspace, StepProblem,
+    StepReport,
 };
 use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
@@ -338,16 +338,6 @@ fn iterate(
     predict(&scheme, problem, h, &ws.previous, state);
     let mut convergence = Convergence::new("", settings, state.time, h);
     ws.anderson.reset();
-    let history = state.iteration;
-    let mut first_correction = 0.0;
-    // One iteration may do where the matrix is the Jacobian but for the frame's rotation: one
-    // co-moving frame, no f_nl, no stiffening, not the full formulation's Newton (with f_nl the
-    // energy of B1's undamped step response drifted to 1.6e-6 of its peak even at a hundredth
-    // of the tolerance, against 1e-6 converged: cantilever_dynamics.rs).
-    let single = matrix.newton.is_none()
-        && body.single_frame()
-        && !body.options.nonlinear_forces
-        && forces.geometric_stiffness.is_none();
     for iteration in 1..=settings.max_iterations {
         let kin = residual(body, free, state, loads, forces);
         if iteration == 1 {
@@ -355,22 +345,7 @@ fn iterate(
         }
         let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
         let largest = matrix.plain_update(body, free, &frame, state, ws, forces);
-        let mut converged = convergence.converged(largest)?;
-        match iteration {
-            1 => {
-                first_correction = largest;
-                converged |=
-                    single && one_iteration_enough(&history, largest, settings.absolute_tolerance);
-                state.iteration.single_steps = history.single_steps.saturating_add(1);
-            }
-            2 => {
-                state.iteration = IterationHistory {
-                    first_contraction: (largest / first_correction).min(1.0),
-                    single_steps: 0,
-                }
-            }
-            _ => {}
-        }
+        let converged = convergence.converged(largest)?;
         if matrix.newton.is_none() {
             mix_update(&mut ws.anderson, converged, &ws.iterate, &mut ws.update);
         }
@@ -388,27 +363,6 @@ fn iterate(
         }
     }
     Err(convergence.failure())
-}
-
-/// A step may stop after its first correction `Δ₁` when the contraction `θ₁` of the last step
-/// that took two iterations was below this (the matrix is the Jacobian but for little: the one
-/// co-moving frame turning slowly) ...
-pub const ONE_ITERATION_CONTRACTION: f64 = 0.1;
-
-/// ... and fewer than this many steps have stopped after one iteration since `θ₁` was measured
-/// (the next takes two iterations and measures it again: the contraction changes with the
-/// motion, and a stale one must not keep accepting).
-pub const ONE_ITERATION_STEPS: u32 = 7;
-
-/// Whether the first correction `Δ₁` (m) leaves an error within `tolerance` by the contraction
-/// of recent steps: `θ₁/(1−θ₁) Δ₁ ≤ tol` (docs/formulation.md, "The fixed-point iteration").
-/// On B1 (h = 0.1 ms, 10 N step load) this halves the iterations, 2 000 to 1 125 in 1 000 steps,
-/// with the same tip motion to 5 digits against a 5 µs reference.
-fn one_iteration_enough(history: &IterationHistory, first: f64, tolerance: f64) -> bool {
-    let theta = history.first_contraction;
-    theta < ONE_ITERATION_CONTRACTION
-        && history.single_steps < ONE_ITERATION_STEPS
-        && theta / (1.0 - theta) * first <= tolerance
 }
 
 /// The predictor at `t_{n+1} = t_n + h` from the step's start `prev`: for the free nodes

@@ -185,30 +185,6 @@ pub struct DynamicState {
     /// (initialization). A step of another length first carries the state over to it
     /// (`generalized_alpha::change_step`).
     pub step_size: f64,
-    /// What generalized-α's iteration has learnt of its own contraction (whether one iteration
-    /// may do).
-    pub iteration: IterationHistory,
-}
-
-/// The contraction of generalized-α's iteration as recent steps showed it: with it a step may
-/// stop after its first correction, when the error that correction leaves (`θ₁/(1−θ₁) Δ₁`,
-/// `θ₁ = Δ₂/Δ₁` of the last step that took two iterations) is within the tolerance
-/// (docs/formulation.md, "The fixed-point iteration").
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IterationHistory {
-    /// `θ₁` of the last step that took two iterations or more (1: not known).
-    pub first_contraction: f64,
-    /// Steps that stopped after one iteration since `θ₁` was measured.
-    pub single_steps: u32,
-}
-
-impl Default for IterationHistory {
-    fn default() -> IterationHistory {
-        IterationHistory {
-            first_contraction: 1.0,
-            single_steps: 0,
-        }
-    }
 }
 
 impl DynamicState {
@@ -222,7 +198,6 @@ impl DynamicState {
             pseudo_acceleration: vec![0.0; dofs],
             multipliers: vec![0.0; multipliers],
             step_size: 0.0,
-            iteration: IterationHistory::default(),
         }
     }
 
@@ -236,7 +211,6 @@ impl DynamicState {
             .copy_from_slice(&other.pseudo_acceleration);
         self.multipliers.copy_from_slice(&other.multipliers);
         self.step_size = other.step_size;
-        self.iteration = other.iteration;
     }
 }
 

@@ -52,6 +52,8 @@ pub struct SensitivityWorkspace {
     derivative: Vec<f64>,
     /// The constraints' directional derivatives (one per multiplier).
     constraint_values: Vec<f64>,
+    /// `δλ` before a correction (to judge the multipliers' convergence).
+    multipliers: Vec<f64>,
     /// The free rows of `r'` in the nodes' frames, then `S̄⁻¹` of them.
     reduced: Vec<f64>,
 }
@@ -63,6 +65,7 @@ impl SensitivityWorkspace {
             previous: DynamicState::zeros(n3, free.multiplier_count()),
             derivative: vec![0.0; n3],
             constraint_values: vec![0.0; free.multiplier_count()],
+            multipliers: vec![0.0; free.multiplier_count()],
             reduced: vec![0.0; free.dof_count()],
         }
     }
@@ -76,10 +79,7 @@ impl SensitivityWorkspace {
 /// worth each: the point constraints' `C δx`, the rigid sets' `h'(δx)`). `base` is the state the
 /// step is linearised about, `frame` its co-moving frame; `forces` holds its slabs' frames (the
 /// iteration matrix's rotations). With constraints the correction is the constrained one, and
-/// `ds.multipliers` carries `δλ`. `single`: the step stopped after its first correction
-/// (`generalized_alpha::one_iteration_enough`, or a predictor within the tolerance), so its map
-/// is the predictor and one correction, and so is this one's. Returns the linear iterations
-/// taken. No allocation.
+/// `ds.multipliers` carries `δλ`. Returns the linear iterations taken. No allocation.
 #[allow(clippy::too_many_arguments)]
 pub fn linear_step(
     matrix: &mut IterationMatrix,
@@ -91,7 +91,6 @@ pub fn linear_step(
     h: f64,
     prescribe: &dyn Fn(f64, &mut DynamicState),
     derivative: &mut ResidualDerivative,
-    single: bool,
     ds: &mut DynamicState,
     ws: &mut SensitivityWorkspace,
 ) -> Result<usize> {
@@ -107,6 +106,7 @@ pub fn linear_step(
     let c_d = scheme.damping_coefficient(h);
     let mut previous = f64::INFINITY;
     let mut reach: f64 = 0.0;
+    let mut multiplier_reach: f64 = 0.0;
     for iteration in 1..=MAX_LINEAR_ITERATIONS {
         derivative(ds, &mut ws.derivative, &mut ws.constraint_values);
         for (k, &i) in free.nodes.iter().enumerate() {
@@ -116,6 +116,7 @@ pub fn linear_step(
         matrix
             .factor
             .solve_in_place(&mut ws.reduced, &mut matrix.workspace);
+        ws.multipliers.copy_from_slice(&ds.multipliers);
         if let Some(constraint) = &mut matrix.constraint {
             constraint.correct_linear(
                 &free.constraints,
@@ -148,7 +149,17 @@ pub fn linear_step(
         // Converged, or stalled at the differences' noise within NOISE_FLOOR.
         let stalled = largest > 0.5 * previous && largest <= NOISE_FLOOR * scale;
         reach = reach.max(largest);
-        if single || largest <= RELATIVE_TOLERANCE * scale || stalled {
+        // The multipliers' correction, against theirs (a load the constraints take is all in
+        // them).
+        let multiplier_change = ds
+            .multipliers
+            .iter()
+            .zip(&ws.multipliers)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        multiplier_reach =
+            multiplier_reach.max(ds.multipliers.iter().fold(0.0_f64, |m, x| m.max(x.abs())));
+        let multipliers_settled = multiplier_change <= RELATIVE_TOLERANCE * multiplier_reach;
+        if (largest <= RELATIVE_TOLERANCE * scale && multipliers_settled) || stalled {
             update_pseudo_acceleration(&scheme, free, &ws.previous, ds);
             return Ok(iteration);
         }
