@@ -2,7 +2,7 @@
 //! error requested, and the run time against the cheapest fixed internal step that reaches the
 //! same error, through `flexbody::slave::Slave` as an importer drives the FMU.
 //!
-//! `cargo run --release --example accuracy_table -- [--quick]`
+//! `cargo run --release --example accuracy_table -- [--quick] [--only b1|b3|rod]`
 //!
 //! * **B1**: the default cantilever (hex20 20×2×2, 1863 DOF), 10 N step load in −y on `tip` at
 //!   t = 0, no damping, ρ∞ = 0.9, 0.1 s, communication step 2 ms, `solver.stepSize` 2 ms (the top
@@ -159,10 +159,28 @@ fn timed(repeats: usize, run: impl Fn() -> Run) -> Run {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
-    let repeats = if quick { 1 } else { 3 };
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    // `--only b1|b3|rod`: one scene.
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1).cloned());
+    let wanted = |name: &str| only.as_deref().is_none_or(|o| o == name);
+    if wanted("b1") {
+        b1_section(quick);
+    }
+    if wanted("b3") {
+        b3_section(quick);
+    }
+    if wanted("rod") {
+        rod_section(quick);
+    }
+}
 
-    // ---- B1 ----------------------------------------------------------------------------------
+/// B1: the fixed steps and the controlled runs (`repeats` runs each, median).
+fn b1_section(quick: bool) {
+    let repeats = if quick { 1 } else { 3 };
     let end = if quick { 0.04 } else { 0.1 };
     let h_ref = if quick { 2e-5 } else { 5e-6 };
     let top = 2e-3;
@@ -235,8 +253,10 @@ fn main() {
             ),
         }
     }
+}
 
-    // ---- B3 ----------------------------------------------------------------------------------
+/// B3: the hand-chosen frames and steps and the controlled runs.
+fn b3_section(quick: bool) {
     let end = if quick { 2.0 } else { 20.0 };
     let h_ref = if quick { 5e-3 } else { 2.5e-3 };
     let reference = b3(
@@ -292,8 +312,10 @@ fn main() {
         b3(&[("model.accuracy", accuracy)], end, 1e-2)
     });
     compare_with_hand_chosen(&controlled, &hand);
+}
 
-    // ---- the connecting rod --------------------------------------------------------------------
+/// The connecting rod: the fixed steps and the controlled runs.
+fn rod_section(quick: bool) {
     let end = if quick { 1e-3 } else { 4e-3 };
     let h_ref = 1e-4 / 64.0;
     let reference = conrod(&[("solver.stepSize", h_ref), ("model.accuracy", 0.0)], end).samples;
@@ -302,24 +324,37 @@ fn main() {
     );
     println!("| setting | internal steps | redone | wall (ms) | error / peak |");
     println!("|---|---|---|---|---|");
-    let mut hand = Vec::new();
     let divisions: &[u32] = if quick { &[1, 4] } else { &[1, 2, 4, 8, 16] };
-    for &d in divisions {
-        let h = 1e-4 / f64::from(d);
-        let r = conrod(&[("solver.stepSize", h), ("model.accuracy", 0.0)], end);
-        let e = relative_error(&r.samples, &reference);
+    let steps: Vec<f64> = divisions.iter().map(|&d| 1e-4 / f64::from(d)).collect();
+    let hand = fixed_step_rows(&steps, &reference, |h| {
+        conrod(&[("solver.stepSize", h), ("model.accuracy", 0.0)], end)
+    });
+    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
+        conrod(&[("model.accuracy", accuracy)], end)
+    });
+    compare_with_hand_chosen(&controlled, &hand);
+}
+
+/// A row per fixed internal step `h`: `run(h)` against `reference`; returns the hand-chosen
+/// settings `(label, wall, error)`.
+fn fixed_step_rows(
+    steps: &[f64],
+    reference: &[f64],
+    run: impl Fn(f64) -> Run,
+) -> Vec<(String, f64, f64)> {
+    let mut rows = Vec::new();
+    for &h in steps {
+        let r = run(h);
+        let e = relative_error(&r.samples, reference);
         let label = format!("fixed h = {h:e} s");
         println!(
             "| {label} | {} | | {:.1} | {e:.3e} |",
             r.steps,
             r.wall * 1e3
         );
-        hand.push((label, r.wall, e));
+        rows.push((label, r.wall, e));
     }
-    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
-        conrod(&[("model.accuracy", accuracy)], end)
-    });
-    compare_with_hand_chosen(&controlled, &hand);
+    rows
 }
 
 /// A row per accuracy: `run(accuracy)` against `reference`; returns `(accuracy, wall, error)`.
