@@ -373,11 +373,14 @@ fn input_derivatives_equal_the_extrapolated_inputs_at_each_internal_step() {
 fn output_derivatives_are_the_rates_of_the_outputs() {
     // rhoInf = 1 (trapezoidal rule): x_{n+1} - x_n = h (v_n + v_{n+1}) / 2 exactly for every
     // node, so for the linear centre-of-mass quantities the trapezoid of the derivatives must
-    // match the change to rounding; the rotation's rates match to second order in h.
+    // match the change to rounding; the rotation's rates match to second order in h. One
+    // internal step per communication step (model.accuracy = 0: the error control would split
+    // it, and the trapezoid holds per internal step).
     let recorder = Recorder::default();
     let c = started(
         &recorder,
         &[
+            ("model.accuracy", 0.0),
             ("solver.rhoInf", 1.0),
             ("tip.force[3]", -10.0),
             ("tip.torque[1]", 2.0),
@@ -575,8 +578,11 @@ fn an_impossible_step_is_discarded_rolled_back_and_a_smaller_one_works() {
 #[test]
 fn the_factorization_cache_stays_bounded_and_exact_under_varying_steps() {
     // Six communication step sizes in turn: at most MATRIX_CACHE_SIZE factorizations are kept,
-    // and a step size that was evicted and factorised again gives the same result.
-    let mut s = common::initialized_default(&[("tip.force[2]", -10.0)]);
+    // and a step size that was evicted and factorised again gives the same result. Each
+    // communication step is one internal step (model.accuracy = 0: the error control would
+    // take rungs of solver.stepSize instead).
+    let settings = [("model.accuracy", 0.0), ("tip.force[2]", -10.0)];
+    let mut s = common::initialized_default(&settings);
     let sizes = [1e-3, 0.9e-3, 0.8e-3, 0.7e-3, 0.6e-3, 0.5e-3];
     let mut t = 0.0;
     for &h in sizes.iter().chain(&sizes) {
@@ -587,7 +593,7 @@ fn the_factorization_cache_stays_bounded_and_exact_under_varying_steps() {
     assert_eq!(s.cached_step_sizes().len(), MATRIX_CACHE_SIZE);
     // Least recently used evicted: the last four sizes are kept, the latest last.
     assert_eq!(s.cached_step_sizes(), sizes[2..].to_vec());
-    let mut fresh = common::initialized_default(&[("tip.force[2]", -10.0)]);
+    let mut fresh = common::initialized_default(&settings);
     let state = s.get_state();
     fresh.set_state(&state).unwrap();
     s.do_step(t, 1e-3).unwrap(); // 1e-3 factorised again (evicted)

@@ -9,6 +9,49 @@ pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
+/// The rigid field `t + θ × (x − c)` nearest to a field `f` over `nodes` in the weighted
+/// least-squares sense, `Σ_i w_i |t + θ × (x_i − c) − f_i|²` (weights `weight(k) ≥ 0` of the
+/// `k`-th of `nodes`, positions `x` flat `3N`): `c` and `t` the weighted means of `x_i` and `f_i`, `θ = I⁻¹ Σ_i w_i
+/// (x_i − c) × f_i` with `I = Σ_i w_i (|r_i|² 1 − r_i r_iᵀ)` (directions in which `I` vanishes,
+/// as about the line of collinear nodes, get no rotation). Returns `(c, t, θ)`; all zero
+/// without weight. No allocation.
+pub fn nearest_rigid_field(
+    nodes: &[usize],
+    weight: impl Fn(usize) -> f64,
+    x: &[f64],
+    f: impl Fn(usize) -> Vector3<f64>,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let (mut total, mut centre, mut mean) = (0.0, Vector3::zeros(), Vector3::zeros());
+    for (k, &i) in nodes.iter().enumerate() {
+        let w = weight(k);
+        total += w;
+        centre += w * node(x, i);
+        mean += w * f(i);
+    }
+    if total <= 0.0 {
+        return (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+    }
+    centre /= total;
+    mean /= total;
+    let (mut inertia, mut moment) = (Matrix3::zeros(), Vector3::zeros());
+    for (k, &i) in nodes.iter().enumerate() {
+        let (w, r) = (weight(k), node(x, i) - centre);
+        inertia += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
+        moment += w * r.cross(&f(i));
+    }
+    let eigen = inertia.symmetric_eigen();
+    let largest = eigen.eigenvalues.amax();
+    let mut rotation = Vector3::zeros();
+    for k in 0..3 {
+        let lambda = eigen.eigenvalues[k];
+        if lambda > 1e-12 * largest {
+            let e = eigen.eigenvectors.column(k);
+            rotation += e * (e.dot(&moment) / lambda);
+        }
+    }
+    (centre, mean, rotation)
+}
+
 /// Node `i` of a flat `3N` vector.
 #[inline]
 pub fn node(v: &[f64], i: usize) -> Vector3<f64> {

@@ -5,6 +5,7 @@
 pub mod feature_indicators;
 pub mod frame;
 pub mod interface;
+pub mod lowest_modes;
 pub mod lumped_body;
 pub mod patches;
 pub mod reduction;
@@ -260,6 +261,22 @@ impl Body {
     /// formulation nor patches.
     pub fn single_frame(&self) -> bool {
         self.full.is_none() && self.patches.is_none()
+    }
+
+    /// `K ū` (N, co-moving frame) of the local deformation of the last
+    /// [`Body::internal_force`] call: the force scratch's own with one frame, else computed
+    /// into `y` (flat `3N`). No allocation.
+    pub fn local_elastic_force<'a>(
+        &self,
+        scratch: &'a ForceScratch,
+        y: &'a mut [f64],
+    ) -> &'a [f64] {
+        if self.single_frame() {
+            scratch.elastic_force()
+        } else {
+            self.stiffness_product(scratch.local_deformation(), y);
+            y
+        }
     }
 
     /// The same body with the full nonlinear formulation of `material` (its `λ`, `μ`).

@@ -4,6 +4,7 @@
 use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
 use crate::body::feature_indicators::{self, FeatureIndicators};
+use crate::body::lowest_modes::{LowestModes, MODES as LOWEST_MODES};
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{Body, BodyOptions, ModeCount, NodeSet, Patches, Reduction};
@@ -65,11 +66,12 @@ pub(super) struct Model {
     /// [`Features::frames`]); `None`: the body gets none (several frames given, the full
     /// formulation, a reduced body, or no accuracy to decide by).
     pub(super) parked_patches: Option<Patches>,
-    /// `T₁ = 2π/ω₁` (s), the period of the lowest natural frequency of the body on its
-    /// supports (of its lowest elastic mode if it has none): the time over which the error
-    /// control lets the errors add up to `model.accuracy` (`slave::step_control`). `None`
-    /// without error control.
-    pub(super) first_period: Option<f64>,
+    /// The body's lowest elastic modes on its supports (of a body without supports: its lowest
+    /// elastic ones), for the error control (`slave::step_control`): the period `T₁ = 2π/ω₁`
+    /// over which it lets the errors add up to `model.accuracy`, the quasi-static displacement
+    /// of the accelerations and the part of a field in these modes. `None` without error
+    /// control.
+    pub(super) lowest_modes: Option<LowestModes>,
     /// The step Jacobian's vectors, allocated on its first use (`Slave::step_jacobian`).
     pub(super) jacobian: Option<super::step_jacobian::JacobianWorkspace>,
 }
@@ -562,10 +564,10 @@ impl Slave {
         });
         let integrator = self.time_integrator(&body, lumped, &free)?;
         let p = &self.parameters;
-        let first_period = (p.accuracy > 0.0 && p.integrator == Integrator::GeneralizedAlpha)
-            .then(|| lowest_period(&free, indicators.as_ref()))
+        let lowest_modes = (p.accuracy > 0.0 && p.integrator == Integrator::GeneralizedAlpha)
+            .then(|| lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta)))
             .transpose()?;
-        if let Some(t1) = first_period {
+        if let Some(t1) = lowest_modes.as_ref().map(LowestModes::first_period) {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
@@ -590,7 +592,7 @@ impl Slave {
             allowed,
             parked_geometric_stiffness: None,
             parked_patches,
-            first_period,
+            lowest_modes,
             jacobian: None,
         });
         self.dynamics = None;
@@ -826,48 +828,53 @@ impl Slave {
     }
 }
 
-/// `T₁ = 2π/ω₁` (s) of the free DOFs' `K_FF`, `M_FF`: from `model.auto`'s modes if it has them,
-/// else by subspace iteration. A body without fixed supports or motion interfaces (pins and
-/// hinges included: the free body's frequency is the scale) has six rigid modes (`ω = 0`): it is
-/// computed on `K + σM` (`σ` far below the elastic `ω²`, which the shift moves by `σ`) and the
-/// seventh eigenvalue is taken.
-fn lowest_period(free: &FreeNodes, indicators: Option<&FeatureIndicators>) -> Result<f64> {
-    let omega = match indicators.and_then(FeatureIndicators::first_frequency) {
-        Some(w) => w,
-        None => {
-            let supported = !free.clamped.is_empty();
-            let (k, m) = free.elastic_matrices();
-            let (k, m) = (&k, &m);
-            let diagonal = |a: &SymmetricCsr, i: usize| {
-                (a.row_ptr[i]..a.row_ptr[i + 1])
-                    .find(|&j| a.col_idx[j] == i)
-                    .map_or(0.0, |j| a.values[j])
-            };
-            let (shift, index) = if supported {
-                (0.0, 0)
-            } else {
-                // 1e-8 of the mean diagonal ratio (a mean of ω² over the mesh, far above ω₁²)
-                // keeps K + σM positive definite and costs a negligible part of ω₁² + σ's
-                // digits.
-                let trace = |a: &SymmetricCsr| (0..a.n).map(|i| diagonal(a, i)).sum::<f64>();
-                (1e-8 * trace(k) / trace(m), 6)
-            };
-            let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
-            let count = (index + 1).min(k.n);
-            let pairs =
-                fem::modal::lowest_eigenpairs(&shifted, m, count, 1e-6, 200).map_err(|e| {
-                    Error::new(format!(
-                        "model.accuracy: the lowest natural frequency: {}",
-                        e.message
-                    ))
-                })?;
-            (pairs.eigenvalues[count - 1] - shift).max(0.0).sqrt()
-        }
+/// The lowest elastic modes of the free DOFs' `K_FF`, `M_FF` ([`LowestModes`]), by subspace
+/// iteration. A body without fixed supports or motion interfaces (pins and hinges included: the
+/// free body's frequencies are the scale) has six rigid modes (`ω = 0`): they are computed on
+/// `K + σM` (`σ` far below the elastic `ω²`, which the shift moves by `σ`) and the first six
+/// are left out.
+fn lowest_modes(free: &FreeNodes, total_mass: f64, damping: (f64, f64)) -> Result<LowestModes> {
+    let supported = !free.clamped.is_empty();
+    let (k, m) = free.elastic_matrices();
+    let (k, m) = (&k, &m);
+    let diagonal = |a: &SymmetricCsr, i: usize| {
+        (a.row_ptr[i]..a.row_ptr[i + 1])
+            .find(|&j| a.col_idx[j] == i)
+            .map_or(0.0, |j| a.values[j])
     };
+    let (shift, index) = if supported {
+        (0.0, 0)
+    } else {
+        // 1e-8 of the mean diagonal ratio (a mean of ω² over the mesh, far above ω₁²)
+        // keeps K + σM positive definite and costs a negligible part of ω₁² + σ's
+        // digits.
+        let trace = |a: &SymmetricCsr| (0..a.n).map(|i| diagonal(a, i)).sum::<f64>();
+        (1e-8 * trace(k) / trace(m), 6)
+    };
+    let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
+    let count = (index + LOWEST_MODES + 1).min(k.n);
+    let mut pairs = fem::modal::lowest_eigenpairs(&shifted, m, count, 1e-6, 200).map_err(|e| {
+        Error::new(format!(
+            "model.accuracy: the lowest natural frequency: {}",
+            e.message
+        ))
+    })?;
+    pairs
+        .eigenvalues
+        .iter_mut()
+        .for_each(|w2| *w2 = (*w2 - shift).max(0.0));
+    let omega = pairs.eigenvalues[index.min(count - 1)].sqrt();
     if !(omega.is_finite() && omega > 0.0) {
         return Err(Error::new(format!(
             "model.accuracy: the lowest natural frequency came out as {omega} rad/s; set model.accuracy = 0 for a fixed internal step"
         )));
     }
-    Ok(2.0 * std::f64::consts::PI / omega)
+    Ok(LowestModes::new(
+        &free.nodes[..free.elastic_nodes],
+        m,
+        &pairs,
+        index,
+        total_mass,
+        damping,
+    ))
 }

@@ -116,6 +116,7 @@ impl Slave {
             quiet_since: [NOT_QUIET; 2],
             ladder: Ladder::default(),
             deformation_scale: 0.0,
+            high_mode_scale: 0.0,
         });
         self.outputs.valid = false;
         Ok(())

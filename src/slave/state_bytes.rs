@@ -11,25 +11,28 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
+//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3]) f64: each motion interface's frame at the start of the last step (zeros and the identity for other interfaces) |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the scale of the modes above the lowest f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
 //! with a message, never a panic or a NaN later.
 
 use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, INTERFACE_SLOTS};
+use crate::body::interface::DrivingFrame;
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
+use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 7;
+pub const PAYLOAD_FORMAT: u32 = 8;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -183,6 +186,12 @@ impl SlaveState {
             w.f64s(&d[1]);
         }
         w.f64s(&self.input_times);
+        for f in &self.driving {
+            w.f64s(f.position.as_slice());
+            w.f64s(f.rotation.transpose().as_slice());
+            w.f64s(f.velocity.as_slice());
+            w.f64s(f.angular_velocity.as_slice());
+        }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
         self.counters.iter().for_each(|&c| w.u64(c));
@@ -211,6 +220,7 @@ impl SlaveState {
                 w.u32(d.ladder.probe_after);
                 w.u8(u8::from(d.ladder.probed));
                 w.f64(d.deformation_scale);
+                w.f64(d.high_mode_scale);
                 w.f64(s.step_size);
             }
         }
@@ -247,6 +257,15 @@ impl Slave {
         }
         let mut input_times = vec![0.0; n];
         r.f64s(&mut input_times, "an input sample time")?;
+        let mut driving = vec![DrivingFrame::default(); n];
+        for f in &mut driving {
+            let mut v = [0.0; 18];
+            r.f64s(&mut v, "a driving frame")?;
+            f.position = Vector3::from_column_slice(&v[0..3]);
+            f.rotation = Matrix3::from_row_slice(&v[3..12]);
+            f.velocity = Vector3::from_column_slice(&v[12..15]);
+            f.angular_velocity = Vector3::from_column_slice(&v[15..18]);
+        }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;
         let counters = [
@@ -268,6 +287,7 @@ impl Slave {
             inputs,
             input_derivatives,
             input_times,
+            driving,
             last_step_size,
             start_time,
             dynamics,
@@ -410,10 +430,16 @@ impl Slave {
                     )));
                 }
                 let deformation_scale = r.f64("the deformation scale")?;
-                if deformation_scale < 0.0 {
-                    return Err(Error::new(format!(
-                        "the serialized FMU state holds a negative deformation scale {deformation_scale}"
-                    )));
+                let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
+                for (scale, name) in [
+                    (deformation_scale, "deformation scale"),
+                    (high_mode_scale, "scale of the modes above the lowest"),
+                ] {
+                    if scale < 0.0 {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state holds a negative {name} {scale}"
+                        )));
+                    }
                 }
                 let step_size = r.f64("the last internal step's length")?;
                 if !(step_size.is_finite() && step_size >= 0.0) {
@@ -443,6 +469,7 @@ impl Slave {
                         probed,
                     },
                     deformation_scale,
+                    high_mode_scale,
                 })
             }
             b => {

@@ -33,10 +33,18 @@
 //! steps in a row below [`PROBE_BELOW`] on a rung, the next one is taken on the rung above (a
 //! probe): if it stays within its allowance the body keeps the coarser rung, if not it is redone
 //! on its own rung and the next probe waits twice as long (at most [`PROBE_LAST`] steps); a
-//! refinement after a kept probe doubles the wait as well, and only quiet growth (below
-//! [`GROW_BELOW`]) resets it, which bounds the cost of probes that fail to a few per cent of the
-//! steps. A step that would not be estimated (one internal step after an input jump) is not
+//! refinement after a kept probe doubles the wait as well, and only a refinement from a
+//! confirmed rung (the scene has become harder) resets it, which bounds the cost of probes that
+//! fail to a few per cent of the steps. A step that would not be estimated (one internal step after an input jump) is not
 //! taken as a probe: a probe is kept on an estimate only.
+//!
+//! **Growth.** A quiet step moves one rung up at once, unless the step was itself redone on a
+//! finer rung. The rung it reaches is unconfirmed like a probe's: a refinement before as many
+//! calm steps as the next probe waits for doubles that wait, and from then on quiet growth
+//! waits too ([`Ladder::may_grow`]). Without that, an estimate that does not fall like `h²`
+//! between two rungs made the body grow, fail and redo at every communication step (B3 at
+//! `model.accuracy = 1e-3` in its steady spin: 1.74 × the allowance on the rung above, 0.005 ×
+//! on its own, 495 communication steps redone).
 
 /// The floor of the allowance in units of the iteration's tolerance `solver.tolerance × size`:
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
@@ -97,12 +105,28 @@ impl Ladder {
         self.level > 0 && self.calm_steps >= self.probe_after
     }
 
-    /// On rung `level` after a quiet step moved it up: the scene has become easier, probes start
-    /// over.
+    /// On rung `level`, probes from the start.
     pub fn on(level: u32) -> Ladder {
         Ladder {
             level,
             ..Ladder::default()
+        }
+    }
+
+    /// Whether a quiet step may move a rung up: at once, unless growth or probes from here
+    /// have failed, then after `probe_after − PROBE_FIRST` calm steps (8, 24, … 248).
+    pub fn may_grow(&self) -> bool {
+        self.calm_steps + PROBE_FIRST >= self.probe_after
+    }
+
+    /// On rung `level` after a quiet step moved it up from this ladder's rung: like a probe, the
+    /// rung is not confirmed until as many calm steps as the next probe waits for.
+    pub fn after_growth(self, level: u32) -> Ladder {
+        Ladder {
+            level,
+            calm_steps: 0,
+            probed: true,
+            ..self
         }
     }
 
@@ -178,6 +202,38 @@ pub fn allowance(accuracy: f64, scale: f64, h: f64, period: f64, floor: f64) -> 
     (accuracy * scale * h / period).max(floor)
 }
 
+/// The error of an internal step against what it may commit (docs/formulation.md, "Time error
+/// control": the errors that last). The step's estimate is split into `low` (m), its part in
+/// the lowest modes, and `high` (m), the rest, each weighted by the share of `T₁` its errors
+/// persist ([`crate::body::lowest_modes::LowestModes::lasting_error`]). The accumulated error of
+/// a mode cannot exceed twice its amplitude, and the modes above the lowest have at most the
+/// amplitude `high_amplitude` `A` (m). With the budget `ε D` (m) and `allowance = ε D h / T₁`:
+///
+/// * if `2A ≤ ε D / √2`, no step size can make the high modes exceed `2A`: they are not
+///   controlled, and the low modes get the rest of the budget in quadrature,
+///   `ratio = low / (allowance √(1 − (2A / ε D)²))`;
+/// * otherwise each part gets half of it: `ratio = max(low, high) / (allowance / √2)`.
+///
+/// Either way the ratio falls like `h²`. What a part is allowed never falls below `floor` (m),
+/// the iteration's noise ([`ITERATION_NOISE`]).
+pub fn error_ratio(
+    low: f64,
+    high: f64,
+    high_amplitude: f64,
+    budget: f64,
+    allowance: f64,
+    floor: f64,
+) -> f64 {
+    let saturated = 2.0 * high_amplitude / budget;
+    if saturated <= FRAC_1_SQRT_2 {
+        low / (allowance * (1.0 - saturated * saturated).sqrt()).max(floor)
+    } else {
+        low.max(high) / (allowance * FRAC_1_SQRT_2).max(floor)
+    }
+}
+
+use std::f64::consts::FRAC_1_SQRT_2;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -222,6 +278,19 @@ mod tests {
         assert!(!confirmed.probed);
         assert_eq!(confirmed.after_refinement(3).probe_after, PROBE_FIRST);
         assert_eq!(Ladder::on(2).probe_after, PROBE_FIRST);
+        // Quiet growth is at once while nothing failed; the rung it reaches is unconfirmed, and
+        // a refinement from it makes the next growth wait.
+        let fresh = Ladder::on(3);
+        assert!(fresh.may_grow());
+        let grown = fresh.after_growth(2);
+        assert!(grown.probed && grown.probe_after == PROBE_FIRST);
+        let mut back = grown.after_refinement(3);
+        assert_eq!(back.probe_after, 2 * PROBE_FIRST);
+        for _ in 0..PROBE_FIRST {
+            assert!(!back.may_grow());
+            back = back.after_step(Some(0.01));
+        }
+        assert!(back.may_grow());
         let mut waits = Vec::new();
         for _ in 0..8 {
             ladder = ladder.after_failed_probe();

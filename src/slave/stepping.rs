@@ -3,9 +3,10 @@
 use super::auto_features::choose_features;
 use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
 use super::step_control::{
-    allowance, finer_level, rung, Ladder, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL,
+    allowance, error_ratio, finer_level, rung, Ladder, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL,
 };
 use super::{LogEvent, Slave};
+use crate::body::lowest_modes::LowestModes;
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
@@ -39,7 +40,14 @@ impl Slave {
         let controlled = self.error_controlled();
         let ladder = self.dynamics.as_ref().unwrap().ladder;
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
-        self.inputs_jumped = self.update_driving_frames()?;
+        self.driving_before.copy_from_slice(&self.driving);
+        self.inputs_jumped = match self.update_driving_frames() {
+            Ok(jumped) => jumped,
+            Err(e) => {
+                self.driving.copy_from_slice(&self.driving_before);
+                return Err(e);
+            }
+        };
         // A probe takes this step on the rung above (step_control, "probes"), if the step
         // there will be estimated (not one internal step after an input jump).
         let mut probing = controlled
@@ -146,8 +154,11 @@ impl Slave {
         });
         match result {
             Ok(()) => {
+                // A quiet step moves a rung up, unless it was just redone on a finer rung or
+                // the rung above has failed soon after it was reached (step_control, "growth").
                 let quiet = self.step_error.is_some_and(|r| r < GROW_BELOW);
-                let next = if controlled && quiet && level > 0 {
+                let grows = level <= ladder.level && ladder.may_grow();
+                let next = if controlled && quiet && grows && level > 0 {
                     level - 1
                 } else {
                     level
@@ -181,7 +192,7 @@ impl Slave {
                         ..ladder.after_failed_probe()
                     }
                 } else if next < level {
-                    Ladder::on(next)
+                    ladder.after_growth(next)
                 } else if probing {
                     ladder.after_kept_probe(next)
                 } else if next > ladder.level {
@@ -197,22 +208,19 @@ impl Slave {
     }
 
     /// The deformation scale's floor from the loads (docs/formulation.md, "Time error
-    /// control"): `‖ẍ‖_M / ω₁²` (m) at the communication point, the quasi-static displacement
-    /// of the current accelerations, so that a load that has just been applied sets the scale
-    /// before the body has deformed.
+    /// control"): the quasi-static displacement of the current accelerations over the lowest
+    /// modes (m, [`LowestModes::quasi_static`]) at the communication point, so that a load that
+    /// has just been applied sets the scale before the body has deformed.
     fn load_scale(&mut self) {
         let model = self.model.as_ref().unwrap();
         let dynamics = self.dynamics.as_mut().unwrap();
-        let period = model.first_period.unwrap();
-        let omega = 2.0 * std::f64::consts::PI / period;
-        let acceleration = mass_weighted_rms(
-            &model.body,
-            &dynamics.state.acceleration,
-            &mut self.scale_scratch,
-        );
-        dynamics.deformation_scale = dynamics
-            .deformation_scale
-            .max(acceleration / (omega * omega));
+        let modes = model
+            .lowest_modes
+            .as_ref()
+            .expect("error control has the modes");
+        let frame = model.body.frame_weights.best_fit(&dynamics.state.position);
+        let quasi_static = modes.quasi_static(&frame.rotation, &dynamics.state.acceleration);
+        dynamics.deformation_scale = dynamics.deformation_scale.max(quasi_static);
     }
 
     /// Whether the internal step is chosen by the error estimate (`model.accuracy > 0` with
@@ -220,7 +228,7 @@ impl Slave {
     fn error_controlled(&self) -> bool {
         self.model
             .as_ref()
-            .is_some_and(|m| m.first_period.is_some())
+            .is_some_and(|m| m.lowest_modes.is_some())
     }
 
     /// Checks a `fmi2DoStep` request against the FMU's time and state.
@@ -337,15 +345,16 @@ impl Slave {
             extrapolate(load, d, age + big_h);
         }
         dynamics.gravity = self.parameters.gravity;
-        if self.step_error.is_some() {
+        if let Some(modes) = self.model.as_ref().and_then(|m| m.lowest_modes.as_ref()) {
             let model = self.model.as_ref().unwrap();
             let dynamics = self.dynamics.as_mut().unwrap();
-            let scale = mass_weighted_rms(
+            observe_deformation(
                 &model.body,
-                model.forces.force_scratch().local_deformation(),
+                modes,
+                &model.forces,
                 &mut self.scale_scratch,
+                dynamics,
             );
-            dynamics.deformation_scale = dynamics.deformation_scale.max(scale);
         }
         self.outputs.valid = false;
         self.watch_strain(t0 + big_h);
@@ -384,6 +393,7 @@ impl Slave {
     fn roll_back(&mut self, t_c: f64, big_h: f64, e: Error) -> Error {
         let dynamics = self.dynamics.as_mut().unwrap();
         dynamics.state.copy_from(self.backup.as_ref().unwrap());
+        self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
         let kind = e.kind;
         let message = format!(
@@ -480,19 +490,16 @@ impl Slave {
         };
         let controlled = self.error_controlled();
         let jumped = self.inputs_jumped;
-        // The allowance of these internal steps, from the deformation scale at the
-        // communication point (it is updated once per communication step, in finish_step).
-        let allowed = match (controlled, self.model.as_ref().and_then(|m| m.first_period)) {
-            (true, Some(period)) => {
-                let scale = self.dynamics.as_ref().unwrap().deformation_scale;
-                allowance(
-                    self.parameters.accuracy,
-                    scale,
-                    hs,
-                    period,
-                    ITERATION_NOISE * floor,
-                )
-            }
+        // The allowance of these internal steps, from the deformation scale (updated after
+        // each step that is estimated, and at the end of each communication step).
+        let period = self
+            .model
+            .as_ref()
+            .and_then(|m| m.lowest_modes.as_ref())
+            .map(LowestModes::first_period);
+        let accuracy = self.parameters.accuracy;
+        let allowed = |scale: f64| match (controlled, period) {
+            (true, Some(period)) => allowance(accuracy, scale, hs, period, ITERATION_NOISE * floor),
             _ => f64::INFINITY,
         };
         let model = self.model.as_mut().expect("the model exists during a step");
@@ -548,7 +555,9 @@ impl Slave {
             // "Time error control".
             let first = tau0 == 0.0 && j == 0;
             settings.estimate_error = (controlled && (last || first) && !(first && jumped))
-                .then_some(GROW_BELOW * allowed);
+                .then_some(
+                    GROW_BELOW * allowed(dynamics.deformation_scale) / std::f64::consts::SQRT_2,
+                );
             let report = model.integrator.step(
                 &problem,
                 &radau_problem,
@@ -560,17 +569,57 @@ impl Slave {
             self.statistics.0 += 1;
             self.statistics.1 += report.iterations as u64;
             if let Some(e) = report.error_estimate {
-                self.step_error = Some(self.step_error.unwrap_or(0.0).max(e / allowed));
+                // The scales take the deformation this step reached (docs/formulation.md, "Time
+                // error control"): a load applied at its start has deformed the body by now.
+                let modes = model
+                    .lowest_modes
+                    .as_ref()
+                    .expect("error control has the modes");
+                observe_deformation(
+                    body,
+                    modes,
+                    &model.forces,
+                    &mut self.scale_scratch,
+                    dynamics,
+                );
+                let rotation = body
+                    .frame_weights
+                    .best_fit(&dynamics.state.position)
+                    .rotation;
+                let d = model
+                    .integrator
+                    .local_error_field()
+                    .expect("generalized-α estimated");
+                let (low, high) = modes.lasting_error(&rotation, d, e);
+                let ratio = error_ratio(
+                    low,
+                    high,
+                    dynamics.high_mode_scale,
+                    accuracy * dynamics.deformation_scale,
+                    accuracy * dynamics.deformation_scale * hs / period.expect("controlled"),
+                    ITERATION_NOISE * floor,
+                );
+                self.step_error = Some(self.step_error.unwrap_or(0.0).max(ratio));
             }
         }
         Ok(())
     }
 }
 
-/// `√(uᵀ M u / m)`: the mass-weighted RMS of a field `u` (flat `3N`, in its units); `y` is
-/// scratch of `3N`.
-fn mass_weighted_rms(body: &crate::body::Body, u: &[f64], y: &mut [f64]) -> f64 {
-    body.mass_times(u, y);
-    let squared: f64 = u.iter().zip(y.iter()).map(|(u, m)| u * m).sum();
-    (squared.max(0.0) / body.total_mass).sqrt()
+/// The scales of the error control (docs/formulation.md, "Time error control") after a step:
+/// `D` and `A` grow to the elastic displacement relative to the supports of the state the last
+/// residual was evaluated at, and to its part above the lowest modes
+/// ([`LowestModes::deformation`]); `y` is scratch of `3N`. No allocation.
+fn observe_deformation(
+    body: &crate::body::Body,
+    modes: &LowestModes,
+    forces: &crate::solver::problem::ResidualWorkspace,
+    y: &mut [f64],
+    dynamics: &mut super::Dynamics,
+) {
+    let scratch = forces.force_scratch();
+    let elastic_force = body.local_elastic_force(scratch, y);
+    let (low, above) = modes.deformation(scratch.local_deformation(), elastic_force);
+    dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
+    dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
 }

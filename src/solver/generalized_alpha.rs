@@ -26,7 +26,7 @@ use super::problem::{
     StepReport,
 };
 use super::woodbury::NonlinearForceCorrection;
-use crate::body::frame::{node, set_node};
+use crate::body::frame::{add_node, nearest_rigid_field, node, set_node};
 use crate::body::{Body, BodyKinematics};
 use crate::error::{Error, Result};
 use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
@@ -268,6 +268,11 @@ pub struct StepWorkspace {
 }
 
 impl StepWorkspace {
+    /// `d` of the last [`IterationMatrix::local_error`] (flat `3N`, global frame, m).
+    pub fn local_error_field(&self) -> &[f64] {
+        &self.error
+    }
+
     /// Workspace with Anderson's acceleration of the default depth ([`DEFAULT_DEPTH`]).
     pub fn new(body: &Body, free: &FreeNodes) -> StepWorkspace {
         Self::with_anderson_depth(body, free, DEFAULT_DEPTH)
@@ -618,6 +623,28 @@ impl IterationMatrix {
             for d in 3 * i..3 * i + 3 {
                 ws.error[d] = coefficient
                     * (state.pseudo_acceleration[d] - ws.previous.pseudo_acceleration[d]);
+            }
+        }
+        if body.reduction.is_none() {
+            // The error relative to the body's rigid motion (docs/formulation.md, "Time error
+            // control"): on a body without prescribed nodes the rigid field nearest to `d`; on
+            // one with them the jerk of its rigid motion as a spin (`rigid_jerk`, exact for a
+            // steady spin), whose error the supports take.
+            let (centre, translation, rotation) = if free.clamped.is_empty() {
+                nearest_rigid_field(
+                    &free.nodes,
+                    |k| body.mass_row_sums[free.nodes[k]],
+                    &state.position,
+                    |i| node(&ws.error, i),
+                )
+            } else {
+                let (jerk, omega, centre) = step_change::rigid_jerk(body, state);
+                let h3 = coefficient * h;
+                (centre, h3 * jerk, -h3 * omega.norm_squared() * omega)
+            };
+            for &i in &free.nodes {
+                let rigid = translation + rotation.cross(&(node(&state.position, i) - centre));
+                add_node(&mut ws.error, i, &-rigid);
             }
         }
         body.mass_times(&ws.error, &mut ws.error_mass);

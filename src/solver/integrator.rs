@@ -250,6 +250,17 @@ impl TimeIntegrator {
         }
     }
 
+    /// The leading term `d` of the local error of the last step that estimated it
+    /// (generalized-α only: `IterationMatrix::local_error`; flat `3N`, global frame, m).
+    pub fn local_error_field(&self) -> Option<&[f64]> {
+        match self {
+            TimeIntegrator::GeneralizedAlpha { workspace, .. } => {
+                Some(workspace.local_error_field())
+            }
+            _ => None,
+        }
+    }
+
     /// Generalized-α's iteration matrix for `h`, if it is the scheme and has one.
     pub fn iteration_matrix(&self, h: f64) -> Option<&IterationMatrix> {
         match self {

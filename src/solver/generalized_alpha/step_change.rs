@@ -2,10 +2,10 @@
 //! change of step"): the velocities carried over from the lag of the old step to that of the new.
 
 use super::GeneralizedAlpha;
-use crate::body::frame::node;
+use crate::body::frame::{nearest_rigid_field, node};
 use crate::body::Body;
 use crate::solver::problem::{DynamicState, FreeNodes};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// Carries a state made by steps of `h` (`state.step_size`) over to steps of `h'`
 /// (docs/formulation.md, "Generalized-α across a change of step"). On a smooth motion the
@@ -53,39 +53,24 @@ pub(super) fn change_step(
 /// directions with no inertia get none). Returns `(ω × a_c, ω, x_c)`. Exact for a steady spin
 /// about a fixed axis (B3 after its spin-up) and for a free body tumbling about its centroid
 /// at a constant rate; a load that jumps moves `a_c`, not `ω`.
-fn rigid_jerk(body: &Body, state: &DynamicState) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+pub(super) fn rigid_jerk(
+    body: &Body,
+    state: &DynamicState,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     let weights = &body.frame_weights;
-    let mut total = 0.0;
-    let (mut centre, mut velocity, mut acceleration) =
-        (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+    let (centre, _, omega) = nearest_rigid_field(
+        &weights.nodes,
+        |k| weights.weights[k],
+        &state.position,
+        |i| node(&state.velocity, i),
+    );
+    let (mut total, mut acceleration) = (0.0, Vector3::zeros());
     for (&i, &w) in weights.nodes.iter().zip(&weights.weights) {
         total += w;
-        centre += w * node(&state.position, i);
-        velocity += w * node(&state.velocity, i);
         acceleration += w * node(&state.acceleration, i);
     }
-    if total <= 0.0 {
-        return (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-    }
-    centre /= total;
-    velocity /= total;
-    acceleration /= total;
-    let mut inertia = Matrix3::zeros();
-    let mut momentum = Vector3::zeros();
-    for (&i, &w) in weights.nodes.iter().zip(&weights.weights) {
-        let r = node(&state.position, i) - centre;
-        inertia += w * (Matrix3::identity() * r.norm_squared() - r * r.transpose());
-        momentum += w * r.cross(&(node(&state.velocity, i) - velocity));
-    }
-    let eigen = inertia.symmetric_eigen();
-    let largest = eigen.eigenvalues.amax();
-    let mut omega = Vector3::zeros();
-    for k in 0..3 {
-        let lambda = eigen.eigenvalues[k];
-        if lambda > 1e-12 * largest {
-            let e = eigen.eigenvectors.column(k);
-            omega += e * (e.dot(&momentum) / lambda);
-        }
+    if total > 0.0 {
+        acceleration /= total;
     }
     (omega.cross(&acceleration), omega, centre)
 }

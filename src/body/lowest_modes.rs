@@ -1,0 +1,251 @@
+//! The body's lowest elastic modes, as the time error control uses them (docs/formulation.md,
+//! "Time error control": the deformation scale and the errors that add up).
+//!
+//! With the mass-normalised modes `φ_j` of the free DOFs (`K φ_j = ω_j² M φ_j`, the elastic ones
+//! only on a body without supports) and a field `v` of the body (flat `3N`; turned into the
+//! reference orientation by the co-moving frame's `R` when it is global), its coordinates in the
+//! lowest modes are `p_j = φ_jᵀ M Rᵀv`, and `√(Σ_j p_j² / m)` is the mass-weighted RMS of its
+//! part in them; the rest lies in the modes above (the modes are M-orthogonal).
+//!
+//! * The **quasi-static displacement** of an acceleration field `a`, the elastic response to
+//!   the load `M a` held, is mode by mode `Σ_j φ_j p_j / ω_j²`: its RMS over the lowest modes,
+//!   `√(Σ_j p_j² / ω_j⁴ / m)`, is a lower bound of the whole, and close to it where the load
+//!   bends the body. (Dividing the whole acceleration field by `ω₁²` instead is an upper bound
+//!   that can be far off: a load on a few nodes accelerates them by `F/m_local`, mostly in modes
+//!   far above `ω₁`; the connecting rod under its piston load: 6.3e-3 m against 2e-6 m.)
+//! * The **elastic displacement** relative to the supports, from the local deformation `ū` and
+//!   `g = K ū` ([`LowestModes::deformation`]).
+//! * The **errors that last**: a local error in mode `j` persists while the mode's damping
+//!   `σ_j = (α + β ω_j²)/2` (1/s, Rayleigh's `α`, `β`) lets it, about `1/σ_j`; over the period
+//!   `T₁` the errors of a step add up with the weight `w_j = min(1, 1/(σ_j T₁))`
+//!   ([`LowestModes::lasting_error`]). The modes above the kept ones get the weight of the
+//!   lowest of them, `ω_top` (they decay at least as fast).
+
+use super::frame::node;
+use crate::fem::modal::EigenPairs;
+use crate::linalg::SymmetricCsr;
+use nalgebra::Matrix3;
+
+/// The elastic modes kept: the two lowest bending pairs of a beam and two more (torsion,
+/// axial or the next bending mode).
+pub const MODES: usize = 6;
+
+/// The lowest elastic modes on the body's free mesh nodes, and the lowest frequency above them.
+#[derive(Debug, Clone)]
+pub struct LowestModes {
+    /// The free mesh nodes (global indices), in the order of the modes' rows.
+    nodes: Vec<usize>,
+    /// `φ_j` by node, then mode, then component: entry `(k, j, c)` at `3 (MODES k + j) + c`
+    /// (kg^-½; modes past `omega_sq.len()` are zero).
+    modes: Vec<f64>,
+    /// `M φ_j`, stored as `modes` (kg^½).
+    mass_modes: Vec<f64>,
+    /// `ω_j²` (1/s²), ascending, positive; at most [`MODES`].
+    omega_sq: Vec<f64>,
+    /// `ω_top²` (1/s²): the lowest eigenvalue above the kept ones (the highest kept if none was
+    /// computed).
+    omega_top_sq: f64,
+    /// `w_j = min(1, 1/(σ_j T₁))` of the kept modes, then of `ω_top`.
+    weights: [f64; MODES + 1],
+    /// The body's mass `m` (kg).
+    total_mass: f64,
+}
+
+impl LowestModes {
+    /// From the eigenpairs `pairs` of `K φ = ω² M φ` on the free mesh nodes `nodes` (`mass`:
+    /// their `M ⊗ I3`), of which the first `rigid` are rigid modes (0, or 6 on a body without
+    /// supports) and are left out; [`MODES`] are kept, the next eigenvalue is `ω_top²`.
+    /// `damping`: Rayleigh's `(α, β)` (1/s, s).
+    pub fn new(
+        nodes: &[usize],
+        mass: &SymmetricCsr,
+        pairs: &EigenPairs,
+        rigid: usize,
+        total_mass: f64,
+        damping: (f64, f64),
+    ) -> LowestModes {
+        let n = nodes.len();
+        let mut modes = vec![0.0; 3 * MODES * n];
+        let mut mass_modes = vec![0.0; 3 * MODES * n];
+        let mut omega_sq = Vec::with_capacity(MODES);
+        let mut omega_top_sq = None;
+        let mut m_phi = vec![0.0; 3 * n];
+        let elastic = pairs.modes.iter().zip(&pairs.eigenvalues).skip(rigid);
+        for (phi, &w2) in elastic.filter(|(_, &w2)| w2 > 0.0) {
+            if omega_sq.len() == MODES {
+                omega_top_sq = Some(w2);
+                break;
+            }
+            mass.mul_vec(phi, &mut m_phi);
+            let j = omega_sq.len();
+            for k in 0..n {
+                let at = 3 * (MODES * k + j);
+                modes[at..at + 3].copy_from_slice(&phi[3 * k..3 * k + 3]);
+                mass_modes[at..at + 3].copy_from_slice(&m_phi[3 * k..3 * k + 3]);
+            }
+            omega_sq.push(w2);
+        }
+        let omega_top_sq = omega_top_sq.unwrap_or(*omega_sq.last().unwrap_or(&f64::INFINITY));
+        let period =
+            2.0 * std::f64::consts::PI / omega_sq.first().copied().unwrap_or(f64::INFINITY).sqrt();
+        let (alpha, beta) = damping;
+        let weight = |w2: f64| (1.0 / ((alpha + beta * w2) / 2.0 * period)).min(1.0);
+        let mut weights = [weight(omega_top_sq); MODES + 1];
+        for (w, &w2) in weights.iter_mut().zip(&omega_sq) {
+            *w = weight(w2);
+        }
+        LowestModes {
+            nodes: nodes.to_vec(),
+            modes,
+            mass_modes,
+            omega_sq,
+            omega_top_sq,
+            weights,
+            total_mass,
+        }
+    }
+
+    /// `T₁ = 2π/ω₁` (s), the period of the lowest elastic mode.
+    pub fn first_period(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.omega_sq[0].sqrt()
+    }
+
+    /// `p_j = ψ_jᵀ Rᵀv` for the stored vectors `ψ_j` (`modes` or `mass_modes`): one pass over
+    /// the nodes, no allocation.
+    fn project(&self, vectors: &[f64], rotation: &Matrix3<f64>, v: &[f64]) -> [f64; MODES] {
+        let mut p = [0.0; MODES];
+        let rt = rotation.transpose();
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let local = rt * node(v, i);
+            let psi = &vectors[3 * MODES * k..3 * MODES * (k + 1)];
+            for (j, p) in p.iter_mut().enumerate() {
+                *p += psi[3 * j] * local.x + psi[3 * j + 1] * local.y + psi[3 * j + 2] * local.z;
+            }
+        }
+        p
+    }
+
+    /// The mass-weighted RMS of the quasi-static displacement of the accelerations `a` (flat
+    /// `3N`, m/s², global) over the lowest modes (m). No allocation.
+    pub fn quasi_static(&self, rotation: &Matrix3<f64>, a: &[f64]) -> f64 {
+        let p = self.project(&self.mass_modes, rotation, a);
+        let squared: f64 = (p.iter().zip(&self.omega_sq))
+            .map(|(p, &w2)| p * p / (w2 * w2))
+            .sum();
+        (squared / self.total_mass).sqrt()
+    }
+
+    /// The errors that last, of a step whose local error is the field `d` (flat `3N`, global,
+    /// m) with the filtered estimate `error` (m, mass-weighted RMS): the weighted RMS of `d`'s
+    /// part in the lowest modes, `√(Σ_j (w_j p_j)² / m)`, and of the rest, `w_top √(error² −
+    /// Σ_j p_j² / m)` (m). No allocation.
+    pub fn lasting_error(&self, rotation: &Matrix3<f64>, d: &[f64], error: f64) -> (f64, f64) {
+        let p = self.project(&self.mass_modes, rotation, d);
+        let (mut plain, mut weighted) = (0.0, 0.0);
+        for (p, w) in p.iter().zip(&self.weights) {
+            plain += p * p;
+            weighted += (w * p).powi(2);
+        }
+        let plain = (plain / self.total_mass).sqrt().min(error);
+        let rest = (error * error - plain * plain).max(0.0).sqrt();
+        (
+            (weighted / self.total_mass).sqrt(),
+            self.weights[MODES] * rest,
+        )
+    }
+
+    /// The elastic displacement relative to the supports (relative to the nearest rigid motion
+    /// on a body without supports) from the local deformation `ū` and its elastic force
+    /// `g = K ū` (flat `3N`, co-moving frame): the mass-weighted RMS of its part in the lowest
+    /// modes and a bound of the rest's (m).
+    ///
+    /// `K` does not see the rigid motion by which `ū` (measured in the best-fit frame) differs
+    /// from the displacement `u` relative to the supports, so `g = K u` and the modal
+    /// coordinates are `q_j = φ_jᵀ M u = φ_jᵀ g / ω_j²` (on the free nodes `K_FF u_F = g_F`).
+    /// The rest carries the energy `ūᵀ g − Σ_j ω_j² q_j²` in modes at or above `ω_top`, so its
+    /// mass norm squared is at most that over `ω_top²`. No allocation.
+    pub fn deformation(&self, local_deformation: &[f64], elastic_force: &[f64]) -> (f64, f64) {
+        let p = self.project(&self.modes, &Matrix3::identity(), elastic_force);
+        let (mut low, mut low_energy) = (0.0, 0.0);
+        for (p, &w2) in p.iter().zip(&self.omega_sq) {
+            low += p * p / (w2 * w2);
+            low_energy += p * p / w2;
+        }
+        let energy = crate::linalg::dot(local_deformation, elastic_force);
+        let above = (energy - low_energy).max(0.0) / self.omega_top_sq;
+        (
+            (low / self.total_mass).sqrt(),
+            (above / self.total_mass).sqrt(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two unit masses on springs to ground along x (k = 1 and 4 N/m): modes e₁ and e₂ (x of
+    /// node 0 and of node 1), ω² = 1 and 4; body mass 2 kg; Rayleigh `(α, β)`.
+    fn two_oscillators(damping: (f64, f64)) -> LowestModes {
+        let identity: Vec<_> = (0..6).map(|i| (i, i, 1.0)).collect();
+        let mass = SymmetricCsr::from_triplets(6, &identity);
+        let mut e1 = vec![0.0; 6];
+        e1[0] = 1.0;
+        let mut e2 = vec![0.0; 6];
+        e2[3] = 1.0;
+        let pairs = EigenPairs {
+            eigenvalues: vec![1.0, 4.0],
+            modes: vec![e1, e2],
+            iterations: 1,
+        };
+        LowestModes::new(&[0, 1], &mass, &pairs, 0, 2.0, damping)
+    }
+
+    #[test]
+    fn the_quasi_static_displacement_is_the_static_response_mode_by_mode() {
+        let modes = two_oscillators((0.0, 0.0));
+        // a = (2, 0, 0 | 8, 0, 0): static response u = M a / k = (2, 2): RMS √((4 + 4)/2) = 2.
+        let a = [2.0, 0.0, 0.0, 8.0, 0.0, 0.0];
+        assert!((modes.quasi_static(&Matrix3::identity(), &a) - 2.0).abs() < 1e-15);
+        // Turned by 90° about z, the same field along the global y is the same response.
+        let turn = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
+        let turned = [0.0, 2.0, 0.0, 0.0, 8.0, 0.0];
+        assert!((modes.quasi_static(&turn, &turned) - 2.0).abs() < 1e-15);
+        assert!((modes.first_period() - 2.0 * std::f64::consts::PI).abs() < 1e-15);
+    }
+
+    #[test]
+    fn errors_last_as_long_as_the_damping_lets_them() {
+        // β = 0.5 s: σ = β ω² / 2 = 0.25 and 1 /s against T₁ = 2π s: weights 1/(σ T₁).
+        let modes = two_oscillators((0.0, 0.5));
+        let period = 2.0 * std::f64::consts::PI;
+        let (w1, w2) = (1.0 / (0.25 * period), 1.0 / period);
+        // d = (3, 0, 0 | 4, 0, 0): p = (3, 4); the estimate has 1 more (RMS²) above the modes,
+        // which gets the weight of ω_top² = 4.
+        let d = [3.0, 0.0, 0.0, 4.0, 0.0, 0.0];
+        let error = (12.5_f64 + 1.0).sqrt();
+        let (low, high) = modes.lasting_error(&Matrix3::identity(), &d, error);
+        let expected = (((w1 * 3.0).powi(2) + (w2 * 4.0).powi(2)) / 2.0).sqrt();
+        assert!((low - expected).abs() < 1e-14, "{low} against {expected}");
+        assert!((high - w2).abs() < 1e-12, "{high} against {w2}");
+        // Undamped, every error lasts the whole period.
+        let (low, high) =
+            two_oscillators((0.0, 0.0)).lasting_error(&Matrix3::identity(), &d, error);
+        assert!((low - 12.5_f64.sqrt()).abs() < 1e-14 && (high - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_deformation_comes_from_the_elastic_force_and_the_rest_is_bounded() {
+        let modes = two_oscillators((0.0, 0.0));
+        // u = (0.5, 0.3, 0 | 0.25, 0, 0) with a stiffness 8 N/m along y at node 0 (a mode above
+        // the kept ones): g = K u = (0.5, 2.4, 0 | 1, 0, 0).
+        let u = [0.5, 0.3, 0.0, 0.25, 0.0, 0.0];
+        let g = [0.5, 2.4, 0.0, 1.0, 0.0, 0.0];
+        let (low, above) = modes.deformation(&u, &g);
+        // In the modes: q = (0.5, 0.25), RMS √(0.3125 / 2).
+        assert!((low - (0.3125_f64 / 2.0).sqrt()).abs() < 1e-15);
+        // Above: the energy 0.72 J over ω_top² = 4 bounds the true 0.3² = 0.09 by 0.18.
+        assert!((above - (0.18_f64 / 2.0).sqrt()).abs() < 1e-15);
+        assert!(above >= (0.09_f64 / 2.0).sqrt());
+    }
+}
