@@ -117,6 +117,7 @@ impl Slave {
             ladder: Ladder::default(),
             deformation_scale: 0.0,
             high_mode_scale: 0.0,
+            estimate_floor: 0.0,
         });
         self.outputs.valid = false;
         Ok(())

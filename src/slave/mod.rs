@@ -84,6 +84,9 @@ struct Dynamics {
     /// `A` (m): the largest mass-weighted RMS seen so far of the elastic displacement's part
     /// above the lowest modes ([`step_control`]).
     high_mode_scale: f64,
+    /// The estimate that refining did not reduce (m): the iteration's or the model's own noise
+    /// in the estimate, below which the error control does not refine ([`step_control`]).
+    estimate_floor: f64,
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -176,6 +179,8 @@ pub struct Slave {
     /// an internal step's error estimate to its allowance (`None`: no step was estimated),
     /// whether an input jumped at its start, and `M ū` for the deformation scale.
     step_error: Option<f64>,
+    /// The largest local error estimate of the current communication step's attempt (m).
+    step_estimate: f64,
     inputs_jumped: bool,
     scale_scratch: Vec<f64>,
     /// Messages for the logger, drained by the FMI layer after each call.
@@ -273,6 +278,7 @@ impl Slave {
             retries: 0,
             rejected: 0,
             step_error: None,
+            step_estimate: 0.0,
             inputs_jumped: false,
             scale_scratch: Vec::new(),
             events: Vec::new(),
@@ -540,6 +546,7 @@ impl Slave {
                 d.ladder = s.ladder;
                 d.deformation_scale = s.deformation_scale;
                 d.high_mode_scale = s.high_mode_scale;
+                d.estimate_floor = s.estimate_floor;
             }
             (d, s) => *d = s.clone(),
         }

@@ -16,7 +16,7 @@
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the scale of the modes above the lowest f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -221,6 +221,7 @@ impl SlaveState {
                 w.u8(u8::from(d.ladder.probed));
                 w.f64(d.deformation_scale);
                 w.f64(d.high_mode_scale);
+                w.f64(d.estimate_floor);
                 w.f64(s.step_size);
             }
         }
@@ -431,7 +432,9 @@ impl Slave {
                 }
                 let deformation_scale = r.f64("the deformation scale")?;
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
+                let estimate_floor = r.f64("the estimate floor")?;
                 for (scale, name) in [
+                    (estimate_floor, "estimate floor"),
                     (deformation_scale, "deformation scale"),
                     (high_mode_scale, "scale of the modes above the lowest"),
                 ] {
@@ -470,6 +473,7 @@ impl Slave {
                     },
                     deformation_scale,
                     high_mode_scale,
+                    estimate_floor,
                 })
             }
             b => {

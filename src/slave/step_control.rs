@@ -50,6 +50,10 @@
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
 pub const ITERATION_NOISE: f64 = 10.0;
 
+/// An estimate that refining did not reduce becomes a floor of the allowance with this margin,
+/// so that the rung it came from is judged within its allowance.
+pub const NOISE_MARGIN: f64 = 4.0;
+
 /// Finest rung: `solver.stepSize / 2^MAX_LEVEL`.
 pub const MAX_LEVEL: u32 = 8;
 

@@ -4,6 +4,7 @@ use super::auto_features::choose_features;
 use super::interfaces::{apply_loads, extrapolate, prescribe_motion};
 use super::step_control::{
     allowance, error_ratio, finer_level, rung, Ladder, GROW_BELOW, ITERATION_NOISE, MAX_LEVEL,
+    NOISE_MARGIN,
 };
 use super::{LogEvent, Slave};
 use crate::body::lowest_modes::LowestModes;
@@ -66,6 +67,8 @@ impl Slave {
         // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
         // H = 2e-4 s). Input derivatives give continuous loads instead.
         let mut failed_probe = false;
+        // The rung and the error ratio of the first attempt that was refined.
+        let mut refined_from: Option<(u32, f64)> = None;
         self.jacobian_step = None;
         let mut taken;
         let result = loop {
@@ -78,6 +81,7 @@ impl Slave {
                 self.load_scale();
             }
             self.step_error = None;
+            self.step_estimate = 0.0;
             let mut result = Ok(());
             for i in 0..n {
                 result = self.internal_step(t0, big_h, i, n, h);
@@ -109,6 +113,31 @@ impl Slave {
                 continue;
             }
             let ratio = self.step_error.unwrap_or(0.0);
+            if let Some((coarser, estimate)) = refined_from {
+                // The ratio falls like h² (4× per rung): one that fell by less than 2 is not the
+                // time step's.
+                if result.is_ok() && ratio > 1.0 && ratio >= 0.5 * estimate {
+                    // Refining did not reduce the estimate: what is left is no error of the time
+                    // step (docs/formulation.md, "Time error control": the estimate floor). The
+                    // step is redone on the rung it came from, judged above that floor.
+                    let dynamics = self.dynamics.as_mut().unwrap();
+                    dynamics.estimate_floor = dynamics
+                        .estimate_floor
+                        .max(NOISE_MARGIN * self.step_estimate);
+                    self.events.push(LogEvent {
+                        category: category::EVENTS,
+                        message: format!(
+                            "model.accuracy: at t = {t0} the estimated error did not fall with the internal step ({ratio:.2} × its allowance with {h:e} s against {estimate:.2} × on the rung {:e} s): what is left is the iteration's or the model's own, and steps are no longer refined for an estimate below {:e} m",
+                            rung(self.parameters.step_size, coarser),
+                            dynamics.estimate_floor
+                        ),
+                    });
+                    dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                    level = coarser;
+                    refined_from = None;
+                    continue;
+                }
+            }
             if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
                 // control"); a probe on the rung it came from.
@@ -135,6 +164,9 @@ impl Slave {
                 });
                 let backup = self.backup.as_ref().unwrap();
                 self.dynamics.as_mut().unwrap().state.copy_from(backup);
+                if !probing && refined_from.is_none() {
+                    refined_from = Some((level, ratio));
+                }
                 level = finer;
                 if probing {
                     probing = false;
@@ -498,8 +530,9 @@ impl Slave {
             .and_then(|m| m.lowest_modes.as_ref())
             .map(LowestModes::first_period);
         let accuracy = self.parameters.accuracy;
+        let noise = (ITERATION_NOISE * floor).max(self.dynamics.as_ref().unwrap().estimate_floor);
         let allowed = |scale: f64| match (controlled, period) {
-            (true, Some(period)) => allowance(accuracy, scale, hs, period, ITERATION_NOISE * floor),
+            (true, Some(period)) => allowance(accuracy, scale, hs, period, noise),
             _ => f64::INFINITY,
         };
         let model = self.model.as_mut().expect("the model exists during a step");
@@ -597,8 +630,12 @@ impl Slave {
                     dynamics.high_mode_scale,
                     accuracy * dynamics.deformation_scale,
                     accuracy * dynamics.deformation_scale * hs / period.expect("controlled"),
-                    ITERATION_NOISE * floor,
+                    noise,
                 );
+                self.step_estimate = self.step_estimate.max(e);
+                if std::env::var_os("FB_DEBUG").is_some() {
+                    eprintln!("DBG t0={t0:.5} hs={hs:.3e} e={e:.3e} low={low:.3e} high={high:.3e} D={:.3e} A={:.3e} ratio={ratio:.3} it={}", dynamics.deformation_scale, dynamics.high_mode_scale, report.iterations);
+                }
                 self.step_error = Some(self.step_error.unwrap_or(0.0).max(ratio));
             }
         }
