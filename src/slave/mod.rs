@@ -93,6 +93,9 @@ pub struct SlaveState {
     inputs: Vec<Inputs>,
     input_derivatives: Vec<InputDerivatives>,
     input_times: Vec<f64>,
+    /// The driving frames of the motion interfaces at the start of the last step, against which
+    /// the next step tells whether its inputs jump.
+    driving: Vec<DrivingFrame>,
     last_step_size: f64,
     start_time: f64,
     dynamics: Option<Dynamics>,
@@ -149,6 +152,8 @@ pub struct Slave {
     step_inputs: step_jacobian::StepInputs,
     /// The driving frames of motion interfaces at the start of the current step.
     driving: Vec<DrivingFrame>,
+    /// `driving` before the current step, put back if the step is rolled back.
+    driving_before: Vec<DrivingFrame>,
     start_time: f64,
     model: Option<Model>,
     dynamics: Option<Dynamics>,
@@ -251,6 +256,7 @@ impl Slave {
             jacobian_step: None,
             step_inputs: step_jacobian::StepInputs::default(),
             driving: vec![DrivingFrame::default(); n_interfaces],
+            driving_before: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
             model: None,
             dynamics: None,
@@ -458,6 +464,7 @@ impl Slave {
         }
         self.start_time = 0.0;
         self.input_times.fill(0.0);
+        self.driving.fill(DrivingFrame::default());
         self.last_step_size = 0.0;
         self.jacobian_step = None;
         self.dynamics = None;
@@ -476,6 +483,7 @@ impl Slave {
             inputs: self.inputs.clone(),
             input_derivatives: self.input_derivatives.clone(),
             input_times: self.input_times.clone(),
+            driving: self.driving.clone(),
             last_step_size: self.last_step_size,
             start_time: self.start_time,
             dynamics: self.dynamics.clone(),
@@ -493,6 +501,7 @@ impl Slave {
         if state.inputs.len() != self.inputs.len()
             || state.input_derivatives.len() != self.inputs.len()
             || state.input_times.len() != self.inputs.len()
+            || state.driving.len() != self.inputs.len()
         {
             return Err(Error::new("the FMU state belongs to another body"));
         }
@@ -500,6 +509,7 @@ impl Slave {
         self.inputs.clone_from(&state.inputs);
         self.input_derivatives.clone_from(&state.input_derivatives);
         self.input_times.clone_from(&state.input_times);
+        self.driving.copy_from_slice(&state.driving);
         self.last_step_size = state.last_step_size;
         self.jacobian_step = None;
         self.start_time = state.start_time;

@@ -11,6 +11,7 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
+//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3]) f64: each motion interface's frame at the start of the last step (zeros and the identity for other interfaces) |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
@@ -22,14 +23,16 @@
 //! with a message, never a panic or a NaN later.
 
 use super::{Dynamics, InputDerivatives, Inputs, Parameters, Slave, SlaveState, INTERFACE_SLOTS};
+use crate::body::interface::DrivingFrame;
 use crate::error::{Error, Result};
 use crate::fem::IsotropicMaterial;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::variables::FixedKey;
 use crate::solver::problem::DynamicState;
+use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 7;
+pub const PAYLOAD_FORMAT: u32 = 8;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -183,6 +186,12 @@ impl SlaveState {
             w.f64s(&d[1]);
         }
         w.f64s(&self.input_times);
+        for f in &self.driving {
+            w.f64s(f.position.as_slice());
+            w.f64s(f.rotation.transpose().as_slice());
+            w.f64s(f.velocity.as_slice());
+            w.f64s(f.angular_velocity.as_slice());
+        }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
         self.counters.iter().for_each(|&c| w.u64(c));
@@ -247,6 +256,15 @@ impl Slave {
         }
         let mut input_times = vec![0.0; n];
         r.f64s(&mut input_times, "an input sample time")?;
+        let mut driving = vec![DrivingFrame::default(); n];
+        for f in &mut driving {
+            let mut v = [0.0; 18];
+            r.f64s(&mut v, "a driving frame")?;
+            f.position = Vector3::from_column_slice(&v[0..3]);
+            f.rotation = Matrix3::from_row_slice(&v[3..12]);
+            f.velocity = Vector3::from_column_slice(&v[12..15]);
+            f.angular_velocity = Vector3::from_column_slice(&v[15..18]);
+        }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;
         let counters = [
@@ -268,6 +286,7 @@ impl Slave {
             inputs,
             input_derivatives,
             input_times,
+            driving,
             last_step_size,
             start_time,
             dynamics,

@@ -39,7 +39,16 @@ impl Slave {
         let controlled = self.error_controlled();
         let ladder = self.dynamics.as_ref().unwrap().ladder;
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
-        self.inputs_jumped = self.update_driving_frames()?;
+        // The driving frames of the last step, put back if this one is rolled back (they tell
+        // the next step whether its inputs jump).
+        self.driving_before.copy_from_slice(&self.driving);
+        self.inputs_jumped = match self.update_driving_frames() {
+            Ok(jumped) => jumped,
+            Err(e) => {
+                self.driving.copy_from_slice(&self.driving_before);
+                return Err(e);
+            }
+        };
         // A probe takes this step on the rung above (step_control, "probes"), if the step
         // there will be estimated (not one internal step after an input jump).
         let mut probing = controlled
@@ -384,6 +393,7 @@ impl Slave {
     fn roll_back(&mut self, t_c: f64, big_h: f64, e: Error) -> Error {
         let dynamics = self.dynamics.as_mut().unwrap();
         dynamics.state.copy_from(self.backup.as_ref().unwrap());
+        self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
         let kind = e.kind;
         let message = format!(
