@@ -32,7 +32,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 8;
+pub const PAYLOAD_FORMAT: u32 = 9;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 

@@ -41,6 +41,8 @@ impl Slave {
         let controlled = self.error_controlled();
         let ladder = self.dynamics.as_ref().unwrap().ladder;
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
+        // The driving frames of the last step, put back if this one is rolled back (they tell
+        // the next step whether its inputs jump).
         self.driving_before.copy_from_slice(&self.driving);
         self.inputs_jumped = match self.update_driving_frames() {
             Ok(jumped) => jumped,
