@@ -116,9 +116,17 @@ impl Slave {
             }
             let ratio = self.step_error.unwrap_or(0.0);
             if let Some((coarser, estimate)) = refined_from {
-                // The ratio falls like h² (4× per rung): one that fell by less than 2 is not the
-                // time step's.
-                if result.is_ok() && ratio > 1.0 && ratio >= 0.5 * estimate {
+                // The ratio falls like h² (4× per rung): one that fell by less than 2 is the
+                // iteration's noise, or a ringing the step does not resolve, whose filtered
+                // estimate is about its amplitude: below half the budget `ε D`, its error (at
+                // most twice its amplitude) is within it either way.
+                let budget =
+                    self.parameters.accuracy * self.dynamics.as_ref().unwrap().deformation_scale;
+                if result.is_ok()
+                    && ratio > 1.0
+                    && ratio >= 0.5 * estimate
+                    && self.step_estimate <= 0.5 * budget
+                {
                     // Refining did not reduce the estimate: what is left is no error of the time
                     // step (docs/formulation.md, "Time error control": the estimate floor). The
                     // step is redone on the rung it came from, judged above that floor.
@@ -635,9 +643,6 @@ impl Slave {
                     noise,
                 );
                 self.step_estimate = self.step_estimate.max(e);
-                if std::env::var_os("FB_DEBUG").is_some() {
-                    eprintln!("DBG t0={t0:.5} hs={hs:.3e} e={e:.3e} low={low:.3e} high={high:.3e} D={:.3e} A={:.3e} ratio={ratio:.3} it={}", dynamics.deformation_scale, dynamics.high_mode_scale, report.iterations);
-                }
                 self.step_error = Some(self.step_error.unwrap_or(0.0).max(ratio));
             }
         }
