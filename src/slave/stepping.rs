@@ -116,15 +116,15 @@ impl Slave {
             }
             let ratio = self.step_error.unwrap_or(0.0);
             if let Some((coarser, estimate)) = refined_from {
-                // The ratio falls like h² (4× per rung): one that fell by less than 2 is the
-                // iteration's noise, or a ringing the step does not resolve, whose filtered
-                // estimate is about its amplitude: below half the budget `ε D`, its error (at
-                // most twice its amplitude) is within it either way.
+                // The ratio falls like h² (4× per rung): one that fell by less than 2 per rung
+                // is the iteration's noise, or a ringing the step does not resolve, whose
+                // filtered estimate is about its amplitude: below half the budget `ε D`, its
+                // error (at most twice its amplitude) is within it either way.
                 let budget =
                     self.parameters.accuracy * self.dynamics.as_ref().unwrap().deformation_scale;
                 if result.is_ok()
                     && ratio > 1.0
-                    && ratio >= 0.5 * estimate
+                    && ratio >= estimate / f64::from(1u32 << (level - coarser))
                     && self.step_estimate <= 0.5 * budget
                 {
                     // Refining did not reduce the estimate: what is left is no error of the time
