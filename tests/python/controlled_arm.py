@@ -79,7 +79,6 @@ class Arm:
     """The arm FMU instantiated and initialized (fmpy's FMU2Slave)."""
 
     def __init__(self, unzipdir: str, model_description, name: str = "arm"):
-        self.md = model_description
         self.vr = {v.name: v.valueReference for v in model_description.modelVariables}
         self.fmu = FMU2Slave(
             guid=model_description.guid,
