@@ -3,8 +3,8 @@
 
 use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
-use crate::body::feature_indicators::{self, FeatureIndicators};
-use crate::body::lowest_modes::{LowestModes, MODES as LOWEST_MODES};
+use crate::body::feature_indicators::FeatureIndicators;
+use crate::body::lowest_modes::LowestModes;
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{Body, BodyOptions, ModeCount, NodeSet, Patches, Reduction};
@@ -15,13 +15,13 @@ use crate::linalg::SymmetricCsr;
 use crate::model::category;
 use crate::model::enumerations::{Formulation, Integrator, Stiffening};
 use crate::model::InterfaceKind;
-use crate::solver::central_difference::CentralDifference;
 use crate::solver::consistent_acceleration::ConsistentAcceleration;
-use crate::solver::generalized_alpha::{GeneralizedAlpha, StepWorkspace};
-use crate::solver::integrator::{Damping, FactorCache, TimeIntegrator};
+use crate::solver::integrator::TimeIntegrator;
 use crate::solver::problem::{FreeNodes, ResidualWorkspace};
-use crate::solver::radau::{RadauIIA, RadauWorkspace};
 use nalgebra::Vector3;
+
+mod checks;
+mod schemes;
 
 /// The terms in force during a step: with `model.auto` chosen per communication step by
 /// [`FeatureIndicators`] among the allowed ones, otherwise the forced switches. Part of the
@@ -220,63 +220,6 @@ impl Slave {
         inside
     }
 
-    /// Lumped bodies (mass points) ride on the mesh body with the reduced-strain formulation and
-    /// no stiffening: anything else is an error naming the interface and what is not supported.
-    fn check_mass_points(&self) -> Result<()> {
-        let p = &self.parameters;
-        let unsupported = if p.mode_count().is_some() {
-            Some("a reduced body (model.modes ≠ 0)")
-        } else if p.formulation == Formulation::Full {
-            Some("model.formulation = full")
-        } else if p.stiffening != Stiffening::None {
-            Some("model.stiffening other than none (the mass points carry no stress)")
-        } else {
-            None
-        };
-        match unsupported {
-            Some(what) => {
-                let name = self
-                    .body_file
-                    .interfaces
-                    .iter()
-                    .find(|i| i.mass.is_some())
-                    .map_or("?", |i| i.name.as_str());
-                Err(Error::new(format!(
-                    "interface '{name}': a lumped body (mass) is not available with {what}"
-                )))
-            }
-            None => Ok(()),
-        }
-    }
-
-    /// Material regions are supported by the reduced-strain body with one frame and no
-    /// stiffening only: anything else is an error naming what is not supported.
-    fn check_regions(&self) -> Result<()> {
-        let (p, regions) = (&self.parameters, &self.body_file.regions);
-        if regions.is_empty() {
-            return Ok(());
-        }
-        let unsupported = if p.formulation == Formulation::Full {
-            Some("model.formulation = full")
-        } else if p.stiffening != Stiffening::None {
-            Some("model.stiffening other than none")
-        } else if p.frames > 1 {
-            Some("model.frames > 1")
-        } else if !p.output_directory.is_empty() {
-            Some("output.directory (the stress output uses one material)")
-        } else {
-            None
-        };
-        match unsupported {
-            Some(what) => Err(Error::new(format!(
-                "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
-                regions[0].name,
-                if regions.len() > 1 { ", ..." } else { "" }
-            ))),
-            None => Ok(()),
-        }
-    }
-
     /// The body on the whole mesh: one co-moving frame, several (`model.frames`), or the full
     /// formulation.
     fn mesh_body(
@@ -412,62 +355,6 @@ impl Slave {
         Ok((Body::reduced(reduction, options), clamped))
     }
 
-    /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
-    /// stiffening, pins or hinges; anything else is an error naming the parameter.
-    pub(super) fn check_reducible(&self) -> Result<()> {
-        let p = &self.parameters;
-        let reason = if p.formulation == Formulation::Full {
-            Some(
-                "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
-            )
-        } else if p.frames > 1 {
-            Some(format!(
-                "model.frames = {}: a reduced body has one co-moving frame",
-                p.frames
-            ))
-        } else if p.stiffening != Stiffening::None {
-            Some(format!(
-                "model.stiffening = {}: geometric stiffening is not projected on the modes",
-                if p.stiffening == Stiffening::Inertial {
-                    "inertial"
-                } else {
-                    "stress"
-                }
-            ))
-        } else if p.integrator == Integrator::CentralDifference {
-            Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
-        } else {
-            self.interfaces
-                .iter()
-                .zip(&self.body_file.interfaces)
-                .find(|(i, spec)| {
-                    matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge)
-                        || (spec.rigid && i.kind == InterfaceKind::Force)
-                })
-                .map(|(i, spec)| {
-                    if i.kind == InterfaceKind::Force {
-                        format!(
-                            "interface '{}' is a rigid force interface: rigid attachments are not available on a reduced body yet (use the mesh body, model.modes = 0)",
-                            spec.name
-                        )
-                    } else {
-                        format!(
-                            "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
-                            spec.name, i.kind
-                        )
-                    }
-                })
-        };
-        match reason {
-            Some(r) => Err(Error::invalid_value(
-                "model.modes",
-                self.parameters.modes,
-                &r,
-            )),
-            None => Ok(()),
-        }
-    }
-
     /// The solver's side of a model build: free nodes, constraints, stiffening, `model.auto`'s
     /// indicators, the schemes, the logs.
     pub(super) fn finish_model(
@@ -565,7 +452,9 @@ impl Slave {
         let integrator = self.time_integrator(&body, lumped, &free)?;
         let p = &self.parameters;
         let lowest_modes = (p.accuracy > 0.0 && p.integrator == Integrator::GeneralizedAlpha)
-            .then(|| lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta)))
+            .then(|| {
+                schemes::lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta))
+            })
             .transpose()?;
         if let Some(t1) = lowest_modes.as_ref().map(LowestModes::first_period) {
             self.events.push(LogEvent {
@@ -657,224 +546,4 @@ impl Slave {
         }
         Ok(free)
     }
-
-    /// A rigid set may carry one held point (a pin, or a hinge, which on a rigid set holds the
-    /// set's centroid and locks its rotation to the axis): two on one rigid set would hold the
-    /// distance between them twice (the constraints are redundant and the iteration stalls on
-    /// the conflict between their linearisations). Error naming the interfaces.
-    fn check_held_points_on_rigid_sets(&self) -> Result<()> {
-        let specs = &self.body_file.interfaces;
-        for (rigid, rigid_spec) in self.interfaces.iter().zip(specs) {
-            let is_rigid_set = rigid_spec.rigid
-                && matches!(
-                    rigid.kind,
-                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
-                );
-            if !is_rigid_set {
-                continue;
-            }
-            let nodes = &rigid.set.frame_weights.nodes;
-            let mut held = Vec::new();
-            for (interface, spec) in self.interfaces.iter().zip(specs) {
-                for (points, _) in &interface.point_constraints {
-                    if points.iter().any(|n| nodes.contains(n)) {
-                        held.push(format!("'{}'", spec.name));
-                    }
-                }
-            }
-            if held.len() > 1 {
-                let count = held.len();
-                held.dedup();
-                return Err(Error::new(format!(
-                    "interface '{}': its rigid set is held at {count} points (by {}), which holds the distance between them twice; a rigid set may be held by one pin or one hinge (which holds the set's centroid and locks its rotation to the axis)",
-                    rigid_spec.name,
-                    held.join(", ")
-                )));
-            }
-        }
-        Ok(())
-    }
-
-    /// `model.auto`'s indicators for the allowed terms of the one-frame reduced-strain body on
-    /// the whole mesh (patches, the full formulation and the reduced body have no switchable
-    /// terms: forced as given), with the decision logged.
-    fn feature_indicators(
-        &mut self,
-        body: &Body,
-        free: &FreeNodes,
-        stiffening: Option<&GeometricStiffening>,
-        allowed: Features,
-    ) -> Option<FeatureIndicators> {
-        let p = &self.parameters;
-        let single =
-            p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
-        if !(p.auto && single && (allowed.nonlinear_forces || allowed.stiffening)) {
-            return None;
-        }
-        let (stiffness, mass) = free.elastic_matrices();
-        let ind = FeatureIndicators::new(
-            &self.mesh,
-            body,
-            &free.nodes[..free.elastic_nodes],
-            &stiffness,
-            &mass,
-            !free.clamped.is_empty(),
-            stiffening,
-        );
-        let verdict = |allowed: bool, estimated: bool, why: &str| {
-            if !allowed {
-                "not allowed (off)".to_string()
-            } else if estimated {
-                "allowed, switched per communication step by its indicator".to_string()
-            } else {
-                format!("allowed, always on ({why})")
-            }
-        };
-        self.events.push(LogEvent {
-            category: category::EVENTS,
-            message: format!(
-                "model.auto: f_nl {}; stiffening {}; lowest natural frequency {}; a term is switched on when {} × its estimated effect exceeds the target solver.tolerance × size = {:.3e} m, off when it stayed below {} of that for one period 2π/ω₁",
-                if allowed.nonlinear_forces && ind.estimates_nonlinear_forces() {
-                    "allowed, kept off: on a body with supports and one co-moving frame it moved B3's peak 9 % away from the full reference (docs/fmu.md, \"Which terms a scene needs\")".to_string()
-                } else {
-                    verdict(
-                        allowed.nonlinear_forces,
-                        ind.estimates_nonlinear_forces(),
-                        "no estimate for a body without fixed supports or motion interfaces: its spurious moment accumulates",
-                    )
-                },
-                verdict(allowed.stiffening, ind.estimates_stiffening(), "no estimate"),
-                ind.first_frequency()
-                    .map_or("not computed".to_string(), |w| format!("{w:.4e} rad/s")),
-                feature_indicators::SAFETY,
-                p.tolerance * self.size,
-                feature_indicators::HYSTERESIS
-            ),
-        });
-        Some(ind)
-    }
-
-    /// The scheme of `solver.integrator`: generalized-α (ρ∞ = `solver.rhoInf`), Radau IIA (not
-    /// with the full formulation: its constant matrices hold the rotated small-strain
-    /// stiffness) or central difference (its stable step logged).
-    fn time_integrator(
-        &mut self,
-        body: &Body,
-        lumped: &[f64],
-        free: &FreeNodes,
-    ) -> Result<TimeIntegrator> {
-        let p = &self.parameters;
-        let depth = p.anderson_depth as usize;
-        Ok(match p.integrator {
-            Integrator::GeneralizedAlpha => TimeIntegrator::GeneralizedAlpha {
-                scheme: GeneralizedAlpha::new(p.rho_inf),
-                cache: FactorCache::new(),
-                workspace: StepWorkspace::with_anderson_depth(body, free, depth),
-            },
-            Integrator::RadauIIA if p.formulation == Formulation::Full => {
-                return Err(Error::new(
-                    "solver.integrator = radauIIA supports model.formulation = reducedStrain only (its constant iteration matrices hold the rotated small-strain stiffness); use generalizedAlpha for the full formulation",
-                ))
-            }
-            Integrator::RadauIIA => TimeIntegrator::RadauIIA {
-                tableau: RadauIIA::new(),
-                cache: FactorCache::new(),
-                workspace: RadauWorkspace::with_anderson_depth(body, free, depth),
-            },
-            Integrator::CentralDifference => {
-                let scheme = CentralDifference::new(body, lumped, free)?;
-                self.events.push(LogEvent {
-                    category: category::EVENTS,
-                    message: format!(
-                        "central difference: highest frequency {:.4e} rad/s, stable step {:.4e} s ({} × 2/ω_max){}",
-                        scheme.highest_frequency,
-                        scheme.stable_step(),
-                        crate::solver::central_difference::STABILITY_MARGIN,
-                        if p.step_size > scheme.stable_step() {
-                            format!(
-                                "; solver.stepSize = {} exceeds it: internal steps are limited to the stable step",
-                                p.step_size
-                            )
-                        } else {
-                            String::new()
-                        }
-                    ),
-                });
-                TimeIntegrator::CentralDifference(scheme)
-            }
-        })
-    }
-
-    /// Builds the model if needed and makes the integrator ready for internal step `h`
-    /// (factorising on a cache miss, logged under `logEvents`).
-    pub(super) fn prepare_step_size(&mut self, h: f64) -> Result<()> {
-        self.ensure_model()?;
-        let p = &self.parameters;
-        let model = self.model.as_mut().unwrap();
-        let damping = Damping {
-            alpha: p.damping_alpha,
-            beta: p.damping_beta,
-        };
-        if let Some(message) = model
-            .integrator
-            .prepare(h, &model.body, &model.free, damping)?
-        {
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// The lowest elastic modes of the free DOFs' `K_FF`, `M_FF` ([`LowestModes`]), by subspace
-/// iteration. A body without fixed supports or motion interfaces (pins and hinges included: the
-/// free body's frequencies are the scale) has six rigid modes (`ω = 0`): they are computed on
-/// `K + σM` (`σ` far below the elastic `ω²`, which the shift moves by `σ`) and the first six
-/// are left out.
-fn lowest_modes(free: &FreeNodes, total_mass: f64, damping: (f64, f64)) -> Result<LowestModes> {
-    let supported = !free.clamped.is_empty();
-    let (k, m) = free.elastic_matrices();
-    let (k, m) = (&k, &m);
-    let diagonal = |a: &SymmetricCsr, i: usize| {
-        (a.row_ptr[i]..a.row_ptr[i + 1])
-            .find(|&j| a.col_idx[j] == i)
-            .map_or(0.0, |j| a.values[j])
-    };
-    let (shift, index) = if supported {
-        (0.0, 0)
-    } else {
-        // 1e-8 of the mean diagonal ratio (a mean of ω² over the mesh, far above ω₁²)
-        // keeps K + σM positive definite and costs a negligible part of ω₁² + σ's
-        // digits.
-        let trace = |a: &SymmetricCsr| (0..a.n).map(|i| diagonal(a, i)).sum::<f64>();
-        (1e-8 * trace(k) / trace(m), 6)
-    };
-    let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
-    let count = (index + LOWEST_MODES + 1).min(k.n);
-    let mut pairs = fem::modal::lowest_eigenpairs(&shifted, m, count, 1e-6, 200).map_err(|e| {
-        Error::new(format!(
-            "model.accuracy: the lowest natural frequency: {}",
-            e.message
-        ))
-    })?;
-    pairs
-        .eigenvalues
-        .iter_mut()
-        .for_each(|w2| *w2 = (*w2 - shift).max(0.0));
-    let omega = pairs.eigenvalues[index.min(count - 1)].sqrt();
-    if !(omega.is_finite() && omega > 0.0) {
-        return Err(Error::new(format!(
-            "model.accuracy: the lowest natural frequency came out as {omega} rad/s; set model.accuracy = 0 for a fixed internal step"
-        )));
-    }
-    Ok(LowestModes::new(
-        &free.nodes[..free.elastic_nodes],
-        m,
-        &pairs,
-        index,
-        total_mass,
-        damping,
-    ))
 }

@@ -1,0 +1,160 @@
+//! The body file's choices checked against the parameters before a model is built: what the
+//! lumped bodies, material regions, reduced bodies and rigid sets support, each refusal an
+//! error naming what is not supported and why.
+
+use super::super::Slave;
+use crate::error::{Error, Result};
+use crate::model::enumerations::{Formulation, Integrator, Stiffening};
+use crate::model::InterfaceKind;
+
+impl Slave {
+    /// Lumped bodies (mass points) ride on the mesh body with the reduced-strain formulation and
+    /// no stiffening: anything else is an error naming the interface and what is not supported.
+    pub(super) fn check_mass_points(&self) -> Result<()> {
+        let p = &self.parameters;
+        let unsupported = if p.mode_count().is_some() {
+            Some("a reduced body (model.modes ≠ 0)")
+        } else if p.formulation == Formulation::Full {
+            Some("model.formulation = full")
+        } else if p.stiffening != Stiffening::None {
+            Some("model.stiffening other than none (the mass points carry no stress)")
+        } else {
+            None
+        };
+        match unsupported {
+            Some(what) => {
+                let name = self
+                    .body_file
+                    .interfaces
+                    .iter()
+                    .find(|i| i.mass.is_some())
+                    .map_or("?", |i| i.name.as_str());
+                Err(Error::new(format!(
+                    "interface '{name}': a lumped body (mass) is not available with {what}"
+                )))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// Material regions are supported by the reduced-strain body with one frame and no
+    /// stiffening only: anything else is an error naming what is not supported.
+    pub(super) fn check_regions(&self) -> Result<()> {
+        let (p, regions) = (&self.parameters, &self.body_file.regions);
+        if regions.is_empty() {
+            return Ok(());
+        }
+        let unsupported = if p.formulation == Formulation::Full {
+            Some("model.formulation = full")
+        } else if p.stiffening != Stiffening::None {
+            Some("model.stiffening other than none")
+        } else if p.frames > 1 {
+            Some("model.frames > 1")
+        } else if !p.output_directory.is_empty() {
+            Some("output.directory (the stress output uses one material)")
+        } else {
+            None
+        };
+        match unsupported {
+            Some(what) => Err(Error::new(format!(
+                "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
+                regions[0].name,
+                if regions.len() > 1 { ", ..." } else { "" }
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
+    /// stiffening, pins or hinges; anything else is an error naming the parameter.
+    pub(in crate::slave) fn check_reducible(&self) -> Result<()> {
+        let p = &self.parameters;
+        let reason = if p.formulation == Formulation::Full {
+            Some(
+                "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
+            )
+        } else if p.frames > 1 {
+            Some(format!(
+                "model.frames = {}: a reduced body has one co-moving frame",
+                p.frames
+            ))
+        } else if p.stiffening != Stiffening::None {
+            Some(format!(
+                "model.stiffening = {}: geometric stiffening is not projected on the modes",
+                if p.stiffening == Stiffening::Inertial {
+                    "inertial"
+                } else {
+                    "stress"
+                }
+            ))
+        } else if p.integrator == Integrator::CentralDifference {
+            Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
+        } else {
+            self.interfaces
+                .iter()
+                .zip(&self.body_file.interfaces)
+                .find(|(i, spec)| {
+                    matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge)
+                        || (spec.rigid && i.kind == InterfaceKind::Force)
+                })
+                .map(|(i, spec)| {
+                    if i.kind == InterfaceKind::Force {
+                        format!(
+                            "interface '{}' is a rigid force interface: rigid attachments are not available on a reduced body yet (use the mesh body, model.modes = 0)",
+                            spec.name
+                        )
+                    } else {
+                        format!(
+                            "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
+                            spec.name, i.kind
+                        )
+                    }
+                })
+        };
+        match reason {
+            Some(r) => Err(Error::invalid_value(
+                "model.modes",
+                self.parameters.modes,
+                &r,
+            )),
+            None => Ok(()),
+        }
+    }
+
+    /// A rigid set may carry one held point (a pin, or a hinge, which on a rigid set holds the
+    /// set's centroid and locks its rotation to the axis): two on one rigid set would hold the
+    /// distance between them twice (the constraints are redundant and the iteration stalls on
+    /// the conflict between their linearisations). Error naming the interfaces.
+    pub(super) fn check_held_points_on_rigid_sets(&self) -> Result<()> {
+        let specs = &self.body_file.interfaces;
+        for (rigid, rigid_spec) in self.interfaces.iter().zip(specs) {
+            let is_rigid_set = rigid_spec.rigid
+                && matches!(
+                    rigid.kind,
+                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                );
+            if !is_rigid_set {
+                continue;
+            }
+            let nodes = &rigid.set.frame_weights.nodes;
+            let mut held = Vec::new();
+            for (interface, spec) in self.interfaces.iter().zip(specs) {
+                for (points, _) in &interface.point_constraints {
+                    if points.iter().any(|n| nodes.contains(n)) {
+                        held.push(format!("'{}'", spec.name));
+                    }
+                }
+            }
+            if held.len() > 1 {
+                let count = held.len();
+                held.dedup();
+                return Err(Error::new(format!(
+                    "interface '{}': its rigid set is held at {count} points (by {}), which holds the distance between them twice; a rigid set may be held by one pin or one hinge (which holds the set's centroid and locks its rotation to the axis)",
+                    rigid_spec.name,
+                    held.join(", ")
+                )));
+            }
+        }
+        Ok(())
+    }
+}
