@@ -207,11 +207,12 @@ fn an_importer_that_splits_steps_does_not_trap_the_error_control_on_a_fine_rung(
         "the slabs' switch refines: finest rung {finest}"
     );
     assert!(!climbs.is_empty(), "no probe climbed back up");
-    // Trapped on its finest rung the split run took 22 internal steps per half step, 44 times
-    // the whole steps' work over these 3 s.
+    // Trapped on its finest rung the split run took 22 internal steps per half step from
+    // 1.67 s on: 334 + 266 × 22 = 6 186 internal steps, 20.6 times the whole steps' 300 over
+    // these 3 s. Measured with probes: 4 094 (13.6 times).
     let (split_steps, whole_steps) = (split.solver_statistics().0, whole.solver_statistics().0);
     assert!(
-        split_steps <= 20 * whole_steps,
+        split_steps <= 15 * whole_steps,
         "the split run took {split_steps} internal steps against {whole_steps}"
     );
     assert!(

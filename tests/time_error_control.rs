@@ -298,3 +298,48 @@ fn a_load_on_a_few_nodes_meets_the_accuracy() {
         assert!(error <= accuracy, "accuracy {accuracy}: error {error:.3e}");
     }
 }
+
+/// A communication step that fails leaves the FMU state as it was, the error control's scales
+/// and `model.auto`'s terms included: the 10 N beam after a few controlled steps, then a load
+/// that grows within the step until no internal step down to the last halving survives (the
+/// plain iteration): the step is discarded, and with the load's rate set back the state's
+/// bytes are those before the attempt but for the four step counters (the work the attempt
+/// did).
+#[test]
+fn a_discarded_step_leaves_the_whole_state_as_it_was() {
+    let mut s = slave(body(), &[("solver.andersonDepth", 0.0)]);
+    let force = vr(&s, "tip.force[2]");
+    for k in 0..5 {
+        s.do_step(k as f64 * H, H).unwrap();
+    }
+    let bytes = |s: &Slave| {
+        let mut b = Vec::new();
+        flexbody::slave::CoSimSlave::state_to_bytes(s, &s.get_state(), &mut b);
+        b
+    };
+    s.set_real(force, -10.0).unwrap();
+    let before = bytes(&s);
+    // The load grows from 10 N at 1e11 N/s over the step: its first internal steps converge
+    // (and are estimated: they deform the beam far more than anything before), a later one not.
+    s.set_real_input_derivatives(&[force], &[1], &[-1e11])
+        .unwrap();
+    let e = s.do_step(5.0 * H, H).unwrap_err();
+    assert!(e.message.contains("rolled back"), "{}", e.message);
+    s.set_real_input_derivatives(&[force], &[1], &[0.0])
+        .unwrap();
+    s.set_real(force, -10.0).unwrap();
+    let after = bytes(&s);
+    // The counters' place (src/slave/state_bytes.rs): format and interface count (8 bytes), the
+    // parameters (270), per interface its inputs, derivatives, sample time and driving frame
+    // (872), the last step size and the start time (16); four u64 counters.
+    let n = 2;
+    let counters = 294 + 872 * n..294 + 872 * n + 32;
+    assert_eq!(after.len(), before.len());
+    let differ: Vec<usize> = (0..after.len())
+        .filter(|&i| after[i] != before[i])
+        .collect();
+    assert!(
+        differ.iter().all(|i| counters.contains(i)),
+        "the discarded step changed the state at bytes {differ:?} (the counters are {counters:?})"
+    );
+}

@@ -81,8 +81,8 @@ struct Dynamics {
     /// The deformation scale `D` (m): the largest mass-weighted RMS elastic displacement seen so
     /// far, or quasi-static displacement of the accelerations ([`step_control`]).
     deformation_scale: f64,
-    /// `A` (m): the largest mass-weighted RMS seen so far of the elastic displacement's part
-    /// above the lowest modes ([`step_control`]).
+    /// `A` (m): the largest seen so far of the bound on the mass-weighted RMS of the elastic
+    /// displacement's part above the lowest modes (its energy over `ω₇²`, [`step_control`]).
     high_mode_scale: f64,
     /// The estimate that refining did not reduce (m): the iteration's or the model's own noise
     /// in the estimate, below which the error control does not refine ([`step_control`]).
@@ -177,7 +177,7 @@ pub struct Slave {
     rejected: u64,
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated),
-    /// whether an input jumped at its start, and `M ū` for the deformation scale.
+    /// whether an input jumped at its start, and `K ū` for the deformation scale.
     step_error: Option<f64>,
     /// The largest local error estimate of the current communication step's attempt (m).
     step_estimate: f64,

@@ -9,7 +9,9 @@
 //! ```
 //!
 //! with `ε = model.accuracy`, `D` the deformation scale (the largest mass-weighted RMS elastic
-//! displacement `√(ūᵀ M ū / m)` seen so far, m) and `T₁ = 2π/ω₁` the period of the body's lowest
+//! displacement relative to the supports seen so far, from the lowest modes, or quasi-static
+//! displacement of the accelerations, m: docs/formulation.md, "The deformation scale") and
+//! `T₁ = 2π/ω₁` the period of the body's lowest
 //! natural frequency: the errors committed over one period of the lowest mode add up to at most
 //! `ε D`. The floor is above the iteration's own error: the estimate differences accelerations
 //! of converged iterates, each off by up to `solver.tolerance × size` in position, which puts a

@@ -51,11 +51,23 @@ impl Slave {
                 return Err(e);
             }
         };
+        // What a failed step puts back besides the state and the driving frames.
+        let before = StepStart::of(self.dynamics.as_ref().unwrap());
+        // Whether the backup holds this step's start (an error before it must not restore it).
+        let mut backed_up = false;
         // A probe takes this step on the rung above (step_control, "probes"), if the step
         // there will be estimated (not one internal step after an input jump).
-        let mut probing = controlled
-            && ladder.probes()
-            && (!self.inputs_jumped || self.internal_steps(big_h, ladder.level - 1)?.0 > 1);
+        let probe_steps = if controlled && ladder.probes() && self.inputs_jumped {
+            match self.internal_steps(big_h, ladder.level - 1) {
+                Ok((n, _)) => n,
+                Err(e) => {
+                    return Err(self.roll_back(t_c, communication_step_size, e, &before, false))
+                }
+            }
+        } else {
+            2
+        };
+        let mut probing = controlled && ladder.probes() && probe_steps > 1;
         let mut level = ladder.level - u32::from(probing);
         self.step_inputs.copy_from(
             &self.inputs,
@@ -72,11 +84,17 @@ impl Slave {
         // The rung and the error ratio of the first attempt that was refined.
         let mut refined_from: Option<(u32, f64)> = None;
         self.jacobian_step = None;
-        let mut taken;
+        let mut taken = (0, 0.0);
         let result = loop {
-            let (n, h) = self.internal_steps(big_h, level)?;
+            let (n, h) = match self.internal_steps(big_h, level) {
+                Ok(step) => step,
+                Err(e) => break Err(e),
+            };
             taken = (n, h);
-            self.prepare_step(h)?;
+            if let Err(e) = self.prepare_step(h) {
+                break Err(e);
+            }
+            backed_up = true;
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
             if controlled && (n > 1 || !self.inputs_jumped) {
@@ -112,6 +130,7 @@ impl Slave {
                         result.unwrap_err().message
                     ),
                 });
+                before.restore_scales(self.dynamics.as_mut().unwrap());
                 continue;
             }
             let ratio = self.step_error.unwrap_or(0.0);
@@ -154,6 +173,7 @@ impl Slave {
                         ),
                     });
                     dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                    before.restore_scales(dynamics);
                     level = coarser;
                     refined_from = None;
                     continue;
@@ -184,7 +204,9 @@ impl Slave {
                     ),
                 });
                 let backup = self.backup.as_ref().unwrap();
-                self.dynamics.as_mut().unwrap().state.copy_from(backup);
+                let dynamics = self.dynamics.as_mut().unwrap();
+                dynamics.state.copy_from(backup);
+                before.restore_scales(dynamics);
                 if !probing && refined_from.is_none() {
                     refined_from = Some((level, ratio));
                 }
@@ -256,7 +278,7 @@ impl Slave {
                 self.finish_step(t0, big_h);
                 Ok(())
             }
-            Err(e) => Err(self.roll_back(t_c, communication_step_size, e)),
+            Err(e) => Err(self.roll_back(t_c, communication_step_size, e, &before, backed_up)),
         }
     }
 
@@ -441,11 +463,28 @@ impl Slave {
         }
     }
 
-    /// After a failed communication step: the state back at `t_c`, and the error `e` worded
-    /// for the importer.
-    fn roll_back(&mut self, t_c: f64, big_h: f64, e: Error) -> Error {
+    /// After a failed communication step: the state back at `t_c` (from the backup, if it was
+    /// taken: `backed_up`), the error control's scales and `model.auto`'s terms as they were
+    /// (`before`), and the error `e` worded for the importer.
+    fn roll_back(
+        &mut self,
+        t_c: f64,
+        big_h: f64,
+        e: Error,
+        before: &StepStart,
+        backed_up: bool,
+    ) -> Error {
         let dynamics = self.dynamics.as_mut().unwrap();
-        dynamics.state.copy_from(self.backup.as_ref().unwrap());
+        if backed_up {
+            dynamics.state.copy_from(self.backup.as_ref().unwrap());
+        }
+        before.restore_scales(dynamics);
+        dynamics.estimate_floor = before.estimate_floor;
+        dynamics.features = before.features;
+        dynamics.quiet_since = before.quiet_since;
+        if let Some(model) = self.model.as_mut() {
+            model.apply_features(before.features);
+        }
         self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
         let kind = e.kind;
@@ -677,4 +716,34 @@ fn observe_deformation(
     let (low, above) = modes.deformation(scratch.local_deformation(), elastic_force);
     dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
     dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
+}
+
+/// What a communication step may change besides the state and the driving frames, as it was at
+/// its start: a failed step puts all of it back, a redone attempt the scales (a rejected
+/// attempt's state, an unresolved ringing's overshoot among others, must not loosen the
+/// allowance of its redo).
+struct StepStart {
+    deformation_scale: f64,
+    high_mode_scale: f64,
+    estimate_floor: f64,
+    features: super::Features,
+    quiet_since: [f64; 2],
+}
+
+impl StepStart {
+    fn of(dynamics: &super::Dynamics) -> StepStart {
+        StepStart {
+            deformation_scale: dynamics.deformation_scale,
+            high_mode_scale: dynamics.high_mode_scale,
+            estimate_floor: dynamics.estimate_floor,
+            features: dynamics.features,
+            quiet_since: dynamics.quiet_since,
+        }
+    }
+
+    /// `D` and `A` as they were.
+    fn restore_scales(&self, dynamics: &mut super::Dynamics) {
+        dynamics.deformation_scale = self.deformation_scale;
+        dynamics.high_mode_scale = self.high_mode_scale;
+    }
 }
