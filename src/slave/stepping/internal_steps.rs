@@ -1,0 +1,233 @@
+//! The internal steps of a communication step: each with its retries at halved steps, the
+//! loads and driving motion at its end, and the error estimate where the error control asks
+//! for one (docs/formulation.md, "Time error control").
+
+use super::super::interfaces::{apply_loads, prescribe_motion};
+use super::super::step_control::{allowance, error_ratio, GROW_BELOW, ITERATION_NOISE};
+use super::super::{LogEvent, Slave};
+use super::MAX_STEP_HALVINGS;
+use crate::body::lowest_modes::LowestModes;
+use crate::error::{Error, ErrorKind, Result};
+use crate::model::category;
+use crate::solver::problem::{DynamicState, IterationSettings, StepProblem};
+use crate::solver::radau::RadauProblem;
+use nalgebra::Vector3;
+
+impl Slave {
+    /// Internal step `i` of `n` (of length `h`) of the communication step from `t0` by `big_h`.
+    /// If it does not converge it is redone as 2, 4, ... 2^[`MAX_STEP_HALVINGS`] steps (each
+    /// halving logged under `logEvents`); the error of the last attempt is returned if none
+    /// converges, with the state back at the start of this internal step. No allocation unless
+    /// a step fails.
+    pub(in crate::slave) fn internal_step(
+        &mut self,
+        t0: f64,
+        big_h: f64,
+        i: usize,
+        n: usize,
+        h: f64,
+    ) -> Result<()> {
+        let tau0 = i as f64 * h;
+        let mut depth = 0;
+        loop {
+            let m = 1usize << depth;
+            let hs = h / m as f64;
+            self.prepare_step_size(hs)?;
+            if depth > 0 {
+                let state = &self.dynamics.as_ref().unwrap().state;
+                self.retry_backup
+                    .get_or_insert_with(|| state.clone())
+                    .copy_from(state);
+            }
+            let result = self.advance(t0, big_h, tau0, hs, m, i + 1 == n);
+            let e = match result {
+                Ok(()) => return Ok(()),
+                Err(e) => e,
+            };
+            if depth > 0 {
+                let state = &mut self.dynamics.as_mut().unwrap().state;
+                state.copy_from(self.retry_backup.as_ref().unwrap());
+            }
+            if e.kind != ErrorKind::Discard {
+                return Err(e);
+            }
+            if depth == MAX_STEP_HALVINGS {
+                return Err(Error::discard(format!(
+                    "the internal step from t = {} (h = {h:e}) did not converge, nor when retried with {m} steps of h/{m} = {hs:e}: {}",
+                    t0 + tau0,
+                    e.message
+                )));
+            }
+            depth += 1;
+            self.retries += 1;
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "internal step from t = {} (h = {hs:e}) did not converge ({}); retrying it as {} steps of {:e} s",
+                    t0 + tau0,
+                    e.message,
+                    1usize << depth,
+                    h / (1usize << depth) as f64
+                ),
+            });
+        }
+    }
+
+    /// `m` internal steps of `hs` (prepared), from `tau0` after the
+    /// communication point `t0`. Force inputs are taken at each internal step's end,
+    /// `u(t0 + τ) = u + u'·τ + u''·τ²/2` (the generalized-α scheme here satisfies the equations
+    /// of motion at the end of each internal step, so this is where the load enters); the last
+    /// internal step of the communication step uses `τ = big_h` exactly.
+    #[allow(clippy::too_many_arguments)]
+    pub(in crate::slave) fn advance(
+        &mut self,
+        t0: f64,
+        big_h: f64,
+        tau0: f64,
+        hs: f64,
+        m: usize,
+        last_of_step: bool,
+    ) -> Result<()> {
+        let floor = self.parameters.tolerance * self.size;
+        let mut settings = IterationSettings {
+            absolute_tolerance: floor,
+            max_iterations: self.parameters.max_iterations.max(1) as usize,
+            estimate_error: None,
+        };
+        let controlled = self.error_controlled();
+        let jumped = self.inputs_jumped;
+        // The allowance of these internal steps, from the deformation scale (updated after
+        // each step that is estimated, and at the end of each communication step).
+        let period = self
+            .model
+            .as_ref()
+            .and_then(|m| m.lowest_modes.as_ref())
+            .map(LowestModes::first_period);
+        let accuracy = self.parameters.accuracy;
+        let noise = (ITERATION_NOISE * floor).max(self.dynamics.as_ref().unwrap().estimate_floor);
+        let allowed = |scale: f64| match (controlled, period) {
+            (true, Some(period)) => allowance(accuracy, scale, hs, period, noise),
+            _ => f64::INFINITY,
+        };
+        let model = self.model.as_mut().expect("the model exists during a step");
+        let dynamics = self.dynamics.as_mut().unwrap();
+        let gravity = Vector3::from(self.parameters.gravity);
+        let interfaces = &self.interfaces;
+        let inputs = &self.inputs;
+        let derivatives = &self.input_derivatives;
+        let ages = &self.input_ages;
+        let tau = std::cell::Cell::new(tau0);
+        let body = &model.body;
+        let loads = |x: &[f64], f: &mut [f64]| {
+            apply_loads(
+                body,
+                interfaces,
+                inputs,
+                Some((derivatives, ages, tau.get())),
+                &gravity,
+                x,
+                f,
+            )
+        };
+        let driving = &self.driving;
+        let prescribe = |t: f64, state: &mut DynamicState| {
+            prescribe_motion(body, interfaces, driving, t - t0, state)
+        };
+        let problem = StepProblem {
+            body,
+            free: &model.free,
+            loads: &loads,
+            prescribe: &prescribe,
+        };
+        // Radau's stages sit inside the step: its loads take the time.
+        let timed_loads = |t: f64, x: &[f64], f: &mut [f64]| {
+            tau.set(t - t0);
+            loads(x, f)
+        };
+        let radau_problem = RadauProblem {
+            body,
+            free: &model.free,
+            loads: &timed_loads,
+            prescribe: &prescribe,
+        };
+        for j in 0..m {
+            let last = last_of_step && j + 1 == m;
+            tau.set(if last {
+                big_h
+            } else {
+                tau0 + (j + 1) as f64 * hs
+            });
+            // The error is estimated on the first internal step of a communication step (where
+            // the inputs jump) and on the last (where the outputs are read): docs/formulation.md,
+            // "Time error control".
+            let first = tau0 == 0.0 && j == 0;
+            settings.estimate_error = (controlled && (last || first) && !(first && jumped))
+                .then_some(
+                    GROW_BELOW * allowed(dynamics.deformation_scale) / std::f64::consts::SQRT_2,
+                );
+            let report = model.integrator.step(
+                &problem,
+                &radau_problem,
+                &settings,
+                hs,
+                &mut dynamics.state,
+                &mut model.forces,
+            )?;
+            self.statistics.0 += 1;
+            self.statistics.1 += report.iterations as u64;
+            if let Some(e) = report.error_estimate {
+                // The scales take the deformation this step reached (docs/formulation.md, "Time
+                // error control"): a load applied at its start has deformed the body by now.
+                let modes = model
+                    .lowest_modes
+                    .as_ref()
+                    .expect("error control has the modes");
+                observe_deformation(
+                    body,
+                    modes,
+                    &model.forces,
+                    &mut self.scale_scratch,
+                    dynamics,
+                );
+                let rotation = body
+                    .frame_weights
+                    .best_fit(&dynamics.state.position)
+                    .rotation;
+                let d = model
+                    .integrator
+                    .local_error_field()
+                    .expect("generalized-α estimated");
+                let (low, high) = modes.lasting_error(&rotation, d, e);
+                let ratio = error_ratio(
+                    low,
+                    high,
+                    dynamics.high_mode_scale,
+                    accuracy * dynamics.deformation_scale,
+                    accuracy * dynamics.deformation_scale * hs / period.expect("controlled"),
+                    noise,
+                );
+                self.step_estimate = self.step_estimate.max(e);
+                self.step_error = Some(self.step_error.unwrap_or(0.0).max(ratio));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The scales of the error control (docs/formulation.md, "Time error control") after a step:
+/// `D` and `A` grow to the elastic displacement relative to the supports of the state the last
+/// residual was evaluated at, and to its part above the lowest modes
+/// ([`LowestModes::deformation`]); `y` is scratch of `3N`. No allocation.
+pub(super) fn observe_deformation(
+    body: &crate::body::Body,
+    modes: &LowestModes,
+    forces: &crate::solver::problem::ResidualWorkspace,
+    y: &mut [f64],
+    dynamics: &mut super::super::Dynamics,
+) {
+    let scratch = forces.force_scratch();
+    let elastic_force = body.local_elastic_force(scratch, y);
+    let (low, above) = modes.deformation(scratch.local_deformation(), elastic_force);
+    dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
+    dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
+}
