@@ -483,6 +483,11 @@ impl Slave {
         }
         self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
+        if backed_up {
+            // The force scratch holds the failed attempt's last residual, which the next step's
+            // model choice reads (model.auto's slabs): evaluated again at the state put back.
+            let _ = self.ensure_outputs();
+        }
         let kind = e.kind;
         let message = format!(
             "doStep from t = {t_c} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {t_c}{}",
