@@ -346,9 +346,8 @@ fn a_discarded_step_leaves_the_whole_state_as_it_was() {
 
 /// What follows a discarded step is what would have followed without it, bit for bit and with
 /// the same internal steps: 100 MN at the tip of the 10 N beam, discarded, then the 10 N again,
-/// against a twin that never tried (the force scratch of the failed attempt's last residual,
-/// which the next step's model choice reads, among others model.auto's slabs, made them differ
-/// by 9e-9 m).
+/// against a twin that never tried (model.auto's slabs were chosen from the last residual's
+/// local deformation, the failed attempt's, and what followed differed by 9e-9 m).
 #[test]
 fn a_discarded_step_changes_nothing_that_follows() {
     let run = |attempt: bool| {

@@ -285,6 +285,20 @@ impl Body {
         self
     }
 
+    /// The co-moving frame `(c, R)` of positions `x` and the local deformation
+    /// `ū_i = Rᵀ(x_i − c) − X̄_i` into `ubar` (flat `3N`, m; docs/formulation.md, "The local
+    /// deformation"). No allocation.
+    pub fn local_deformation(&self, x: &[f64], ubar: &mut [f64]) -> Frame {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let rt = frame.rotation.transpose();
+        for i in 0..self.node_count() {
+            let u = rt * (node(x, i) - fw.unit(i) * frame.origin) - fw.reference_offsets[i];
+            set_node(ubar, i, &u);
+        }
+        frame
+    }
+
     /// Number of nodes `N`.
     pub fn node_count(&self) -> usize {
         self.reference.len() / 3
@@ -347,15 +361,11 @@ impl Body {
         f: &mut [f64],
     ) -> BodyKinematics {
         let fw = &self.frame_weights;
-        let frame = fw.best_fit(x);
+        let frame = self.local_deformation(x, &mut scratch.local_deformation);
         let r = frame.rotation;
         let rt = r.transpose();
         let n = self.node_count();
         let ubar = &mut scratch.local_deformation;
-        for i in 0..n {
-            let u = rt * (node(x, i) - fw.unit(i) * frame.origin) - fw.reference_offsets[i];
-            set_node(ubar, i, &u);
-        }
         let g = &mut scratch.elastic_force;
         let strain_energy = if let Some(full) = &self.full {
             full.internal_force(x, g); // global frame

@@ -23,6 +23,7 @@ pub(super) fn choose_features(
     target: f64,
     accuracy: f64,
     events: &mut Vec<LogEvent>,
+    scratch: &mut [f64],
 ) {
     if let Some(indicators) = model.indicators.as_mut() {
         let s = &dynamics.state;
@@ -100,7 +101,7 @@ pub(super) fn choose_features(
         );
         dynamics.features = f;
     }
-    choose_slabs(model, dynamics, accuracy, events);
+    choose_slabs(model, dynamics, accuracy, events, scratch);
     model.apply_features(dynamics.features);
 }
 
@@ -128,7 +129,13 @@ pub(super) const SWITCH_AT: f64 = 0.25;
 /// with the slabs on (just switched on, or later as the body goes on bending violently),
 /// `Slave::do_step` redoes it with the one frame and the slabs are not tried again (B1 under
 /// 5 kN, far beyond small strain).
-fn choose_slabs(model: &Model, dynamics: &mut Dynamics, accuracy: f64, events: &mut Vec<LogEvent>) {
+fn choose_slabs(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    accuracy: f64,
+    events: &mut Vec<LogEvent>,
+    local_deformation: &mut [f64],
+) {
     let f = dynamics.features;
     if !model.allowed.frames || f.frames || f.frames_refused {
         return;
@@ -136,7 +143,12 @@ fn choose_slabs(model: &Model, dynamics: &mut Dynamics, accuracy: f64, events: &
     let Some((monitor, _)) = &model.strain_monitor else {
         return;
     };
-    let g = monitor.largest_gradient(model.forces.force_scratch().local_deformation());
+    // From the state (not the last residual's scratch, which depends on what was evaluated
+    // last: a rejected attempt, an output request).
+    model
+        .body
+        .local_deformation(&dynamics.state.position, local_deformation);
+    let g = monitor.largest_gradient(local_deformation);
     let estimate = BENDING_ERROR * g * g;
     if estimate > SWITCH_AT * accuracy {
         dynamics.features.frames = true;

@@ -176,12 +176,13 @@ pub struct Slave {
     /// the accuracy ([`step_control`]).
     rejected: u64,
     /// The error control's scratch over the communication step under way: the largest ratio of
-    /// an internal step's error estimate to its allowance (`None`: no step was estimated),
-    /// whether an input jumped at its start, and `K ū` for the deformation scale.
+    /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
     /// The largest local error estimate of the current communication step's attempt (m).
     step_estimate: f64,
+    /// Whether an input jumped at the start of the communication step under way.
     inputs_jumped: bool,
+    /// Scratch of `3N`: `K ū` for the deformation scale, `ū` of the state for `model.auto`.
     scale_scratch: Vec<f64>,
     /// Messages for the logger, drained by the FMI layer after each call.
     events: Vec<LogEvent>,

@@ -37,6 +37,7 @@ impl Slave {
         let controlled = self.error_controlled();
         let ladder = self.dynamics.as_ref().unwrap().ladder;
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
+        self.jacobian_step = None;
         // The driving frames of the last step, put back if this one is rolled back (they tell
         // the next step whether its inputs jump).
         self.driving_before.copy_from_slice(&self.driving);
@@ -79,7 +80,6 @@ impl Slave {
         let mut failed_probe = false;
         // The rung and the error ratio of the first attempt that was refined.
         let mut refined_from: Option<(u32, f64)> = None;
-        self.jacobian_step = None;
         let mut taken = (0, 0.0);
         let result = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
@@ -278,10 +278,10 @@ impl Slave {
         }
     }
 
-    /// The deformation scale's floor from the loads (docs/formulation.md, "Time error
-    /// control"): the quasi-static displacement of the current accelerations over the lowest
-    /// modes (m, [`crate::body::lowest_modes::LowestModes::quasi_static`]) at the communication point, so that a load that
-    /// has just been applied sets the scale before the body has deformed.
+    /// The deformation scale's floor from the loads (docs/formulation.md, "Time error control"):
+    /// the quasi-static displacement of the current accelerations over the lowest modes (m,
+    /// [`crate::body::lowest_modes::LowestModes::quasi_static`]) at the communication point, so
+    /// that a load that has just been applied sets the scale before the body has deformed.
     fn load_scale(&mut self) {
         let model = self.model.as_ref().unwrap();
         let dynamics = self.dynamics.as_mut().unwrap();
@@ -362,9 +362,10 @@ impl Slave {
             .unwrap_or(big_h)
     }
 
-    /// Everything a communication step needs before its first internal step (the driving
-    /// frames are set before): the factorization for `h` (on a cache miss; an error here leaves the state), the
-    /// terms in force, the geometric stiffness of the current prestress and the backup.
+    /// Everything a communication step needs before its first internal step (the driving frames
+    /// are set before): the factorization for `h` (on a cache miss; an error here leaves the
+    /// state), the terms in force, the geometric stiffness of the current prestress and the
+    /// backup.
     fn prepare_step(&mut self, h: f64) -> Result<()> {
         self.prepare_step_size(h)?;
         let model = self
@@ -378,6 +379,7 @@ impl Slave {
             self.parameters.tolerance * self.size,
             self.parameters.accuracy,
             &mut self.events,
+            &mut self.scale_scratch,
         );
         if let (Some(stiffening), Some(k_g)) = (
             model.stiffening.as_mut(),
@@ -483,11 +485,6 @@ impl Slave {
         }
         self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
-        if backed_up {
-            // The force scratch holds the failed attempt's last residual, which the next step's
-            // model choice reads (model.auto's slabs): evaluated again at the state put back.
-            let _ = self.ensure_outputs();
-        }
         let kind = e.kind;
         let message = format!(
             "doStep from t = {t_c} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {t_c}{}",
