@@ -11,9 +11,9 @@ pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
 
 /// The rigid field `t + θ × (x − c)` nearest to a field `f` over `nodes` in the weighted
 /// least-squares sense, `Σ_i w_i |t + θ × (x_i − c) − f_i|²` (weights `weight(k) ≥ 0` of the
-/// `k`-th of `nodes`, positions `x` flat `3N`): `c` and `t` the weighted means of `x_i` and `f_i`, `θ = I⁻¹ Σ_i w_i
-/// (x_i − c) × f_i` with `I = Σ_i w_i (|r_i|² 1 − r_i r_iᵀ)` (directions in which `I` vanishes,
-/// as about the line of collinear nodes, get no rotation). Returns `(c, t, θ)`; all zero
+/// `k`-th of `nodes`, positions `x` flat `3N`): `c` and `t` the weighted means of `x_i` and
+/// `f_i`, `θ = I⁻¹ Σ_i w_i (x_i − c) × f_i` with `I = Σ_i w_i (|r_i|² 1 − r_i r_iᵀ)`
+/// (directions in which `I` vanishes, as about the line of collinear nodes, get no rotation). Returns `(c, t, θ)`; all zero
 /// without weight. No allocation.
 pub fn nearest_rigid_field(
     nodes: &[usize],

@@ -11,8 +11,7 @@
 //! with `ε = model.accuracy`, `D` the deformation scale (the largest mass-weighted RMS elastic
 //! displacement relative to the supports seen so far, from the lowest modes, or quasi-static
 //! displacement of the accelerations, m: docs/formulation.md, "The deformation scale") and
-//! `T₁ = 2π/ω₁` the period of the body's lowest
-//! natural frequency: the errors committed over one period of the lowest mode add up to at most
+//! `T₁ = 2π/ω₁` the period of the body's lowest natural frequency: the errors committed over one period of the lowest mode add up to at most
 //! `ε D`. The floor is above the iteration's own error: the estimate differences accelerations
 //! of converged iterates, each off by up to `solver.tolerance × size` in position, which puts a
 //! noise of `(β − 1/6)/β` of that into `e` whatever `h` is; asking the time step for less would
@@ -37,8 +36,8 @@
 //! on its own rung and the next probe waits twice as long (at most [`PROBE_LAST`] steps); a
 //! refinement after a kept probe doubles the wait as well, and only a refinement from a
 //! confirmed rung (the scene has become harder) resets it, which bounds the cost of probes that
-//! fail to a few per cent of the steps. A step that would not be estimated (one internal step after an input jump) is not
-//! taken as a probe: a probe is kept on an estimate only.
+//! fail to a few per cent of the steps. A step that would not be estimated (one internal step
+//! after an input jump) is not taken as a probe: a probe is kept on an estimate only.
 //!
 //! **Growth.** A quiet step moves one rung up at once, unless the step was itself redone on a
 //! finer rung. The rung it reaches is unconfirmed like a probe's: a refinement before as many

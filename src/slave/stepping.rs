@@ -54,17 +54,15 @@ impl Slave {
         let mut backed_up = false;
         // A probe takes this step on the rung above (step_control, "probes"), if the step
         // there will be estimated (not one internal step after an input jump).
-        let probe_steps = if controlled && ladder.probes() && self.inputs_jumped {
-            match self.internal_steps(big_h, ladder.level - 1) {
-                Ok((n, _)) => n,
+        let mut probing = controlled && ladder.probes();
+        if probing && self.inputs_jumped {
+            probing = match self.internal_steps(big_h, ladder.level - 1) {
+                Ok((n, _)) => n > 1,
                 Err(e) => {
                     return Err(self.roll_back(t_c, communication_step_size, e, &before, false))
                 }
-            }
-        } else {
-            2
-        };
-        let mut probing = controlled && ladder.probes() && probe_steps > 1;
+            };
+        }
         let mut level = ladder.level - u32::from(probing);
         self.step_inputs.copy_from(
             &self.inputs,

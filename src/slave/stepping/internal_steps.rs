@@ -203,7 +203,13 @@ impl Slave {
                     high,
                     dynamics.high_mode_scale,
                     accuracy * dynamics.deformation_scale,
-                    accuracy * dynamics.deformation_scale * hs / period.expect("controlled"),
+                    allowance(
+                        accuracy,
+                        dynamics.deformation_scale,
+                        hs,
+                        period.expect("controlled"),
+                        0.0,
+                    ),
                     noise,
                 );
                 self.step_estimate = self.step_estimate.max(e);
