@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use flexbody::body::{ModeCount, NodeSet, Reduction};
+use flexbody::body::{InterfaceSets, MeshData, ModeCount, NodeSet, Reduction};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;
@@ -67,6 +67,18 @@ impl B1 {
             / fw.total_weight
     }
 
+    /// The mesh data of a reduction with `Ms` and `K` (no rigid sets, no mass points).
+    fn mesh_data<'a>(&'a self, ms: &'a SymmetricCsr, k: &'a SymmetricCsr) -> MeshData<'a> {
+        MeshData {
+            reference: &self.reference,
+            mass: ms,
+            stiffness: k,
+            force_stiffness: None,
+            lumped: &self.lumped,
+            frame_weights: &self.lumped,
+        }
+    }
+
     /// Steel's `K` and `Ms` on the mesh, and the reduction with `boundary` sets, `loaded` sets
     /// and `modes` fixed-interface modes.
     fn reduced(
@@ -79,12 +91,12 @@ impl B1 {
         let k = stiffness_matrix(&self.mesh, &material);
         let ms = scalar_mass_matrix(&self.mesh, material.density);
         let reduction = Reduction::new(
-            &self.reference,
-            &ms,
-            &k,
-            &self.lumped,
-            boundary,
-            loaded,
+            &self.mesh_data(&ms, &k),
+            &InterfaceSets {
+                held: boundary,
+                rigid: &[],
+                loaded,
+            },
             ModeCount::Fixed(modes),
         )
         .unwrap();
@@ -286,12 +298,12 @@ fn auto_mode_count_meets_the_accuracy_on_the_inertial_load() {
     let mut counts = Vec::new();
     for accuracy in [1e-2, 1e-3, 1e-4] {
         let reduction = Reduction::new(
-            &b1.reference,
-            &ms,
-            &k,
-            &b1.lumped,
-            &[&b1.root],
-            &[&b1.tip],
+            &b1.mesh_data(&ms, &k),
+            &InterfaceSets {
+                held: &[&b1.root],
+                rigid: &[],
+                loaded: &[&b1.tip],
+            },
             ModeCount::Accuracy(accuracy),
         )
         .unwrap();

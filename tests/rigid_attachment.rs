@@ -3,6 +3,7 @@
 //! attachments").
 
 mod common;
+use common::rigid::*;
 use common::*;
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
@@ -55,13 +56,6 @@ fn tip_history(body: BodyFile, h: f64, steps: usize) -> Vec<f64> {
             get(&mut s, "tip.position[2]")
         })
         .collect()
-}
-
-fn largest_difference(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 /// A rigid block is the limit of a stiff one: a region `r` times stiffer than the beam deforms
@@ -144,169 +138,37 @@ fn a_rigid_pivot_face_keeps_its_shape_through_a_large_swing() {
     );
 }
 
-/// The largest distance of a node of `set` at `x` from the best rigid motion of the set's
-/// reference positions (least squares, equal weights).
-fn distance_from_rigid(reference: &[f64], x: &[f64], set: &[usize]) -> f64 {
-    let p = |v: &[f64], i: usize| Vector3::new(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
-    let n = set.len() as f64;
-    let c0 = set.iter().map(|&i| p(reference, i)).sum::<Vector3<f64>>() / n;
-    let c = set.iter().map(|&i| p(x, i)).sum::<Vector3<f64>>() / n;
-    let a = set.iter().fold(nalgebra::Matrix3::zeros(), |a, &i| {
-        a + (p(x, i) - c) * (p(reference, i) - c0).transpose()
-    });
-    let r = flexbody::body::frame::nearest_rotation(&a);
-    set.iter()
-        .map(|&i| (p(x, i) - c - r * (p(reference, i) - c0)).norm())
-        .fold(0.0, f64::max)
-}
-
-/// The tumbling beam of B2 (free, no supports) with a lumped hub on a rigid face at x = 0.
-fn free_beam_with_hub(hub: bool) -> BodyFile {
-    let hub = if hub {
-        r#", "rigid": true, "mass": 2.5, "centerOfMass": [-0.05, 0.01, 0.0],
-        "inertia": [[0.02, 0.001, 0.0], [0.001, 0.03, -0.002], [0.0, -0.002, 0.025]]"#
-    } else {
-        ""
-    };
-    BodyFile::from_json(&format!(
-        r#"{{
-  "name": "hub",
-  "mesh": {{ "beam": {{ "length": 1.0, "width": 0.02, "height": 0.02, "divisions": [10, 1, 1], "element": "hex20" }} }},
-  "material": {{ "youngsModulus": 2.1e11, "poissonRatio": 0.3, "density": 7850.0 }},
-  "interfaces": [
-    {{ "name": "hub", "kind": "force", "nodes": {{ "plane": {{ "point": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] }} }}, "referencePoint": [0.0, 0.0, 0.0]{hub} }}
-  ],
-  "solver": {{ "stepSize": 1e-3, "rhoInf": 1.0, "tolerance": 1e-12, "maxIterations": 50 }}
-}}"#
-    ))
-    .unwrap()
-}
-
 /// A lumped hub's inertia adds to the body's exactly: the body placed spinning at `ω` about
 /// the body file's origin has the kinetic energy and linear momentum of the beam plus
 /// `½ ωᵀ I_O ω` and `m ω × x_c` of the hub (`I_O` its inertia about the origin, which is the
 /// hub's reference point here): its six mass points carry its mass, centre and inertia.
 #[test]
 fn a_lumped_hub_adds_its_inertia_exactly() {
-    let omega = Vector3::new(0.3, -1.2, 2.0);
-    let spin = [
-        ("initial.angularVelocity[1]", omega.x),
-        ("initial.angularVelocity[2]", omega.y),
-        ("initial.angularVelocity[3]", omega.z),
-    ];
-    let mut with = initialized(free_beam_with_hub(true), &spin);
-    let mut without = initialized(free_beam_with_hub(false), &spin);
-    let (m, c) = (2.5, Vector3::new(-0.05, 0.01, 0.0));
-    let inertia = nalgebra::Matrix3::new(0.02, 0.001, 0.0, 0.001, 0.03, -0.002, 0.0, -0.002, 0.025);
-    let energy = get(&mut with, "body.kineticEnergy") - get(&mut without, "body.kineticEnergy");
-    let expected = 0.5 * omega.dot(&(inertia * omega));
-    let momentum =
-        vector(&mut with, "body.linearMomentum") - vector(&mut without, "body.linearMomentum");
-    println!("ΔT {energy:.15e} J against {expected:.15e} J; ΔP {momentum:?}");
-    assert!(
-        (energy - expected).abs() < 1e-12 * expected,
-        "{energy} J against {expected} J"
-    );
-    assert!((momentum - m * omega.cross(&c)).norm() < 1e-12 * m * omega.norm());
-}
-
-/// `1 + cos β cosh β + α β (cos β sinh β − sin β cosh β) − κ β³ (cosh β sin β + sinh β cos β)
-/// + α κ β⁴ (1 − cos β cosh β) = 0`: the frequency equation of an Euler–Bernoulli cantilever
-/// with a tip mass `α ρAL` and rotary inertia `κ ρAL³` (`ω = β² √(EI / ρAL⁴)`); its lowest root
-/// by bisection (checked against a shooting solution of `W'''' = β⁴ W` with the tip's shear and
-/// moment conditions: 1.24792 for `α = 1, κ = 0`, 1.87510 without a tip body).
-fn tip_mass_root(alpha: f64, kappa: f64) -> f64 {
-    let f = |b: f64| {
-        let (c, ch, s, sh) = (b.cos(), b.cosh(), b.sin(), b.sinh());
-        1.0 + c * ch + alpha * b * (c * sh - s * ch) - kappa * b.powi(3) * (ch * s + sh * c)
-            + alpha * kappa * b.powi(4) * (1.0 - c * ch)
-    };
-    let (mut lo, mut hi) = (0.1, 1.875104068711961);
-    let f_lo = f(lo);
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if (f(mid) > 0.0) == (f_lo > 0.0) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    lumped_hub_inertia(&[]);
 }
 
 /// B1 with a tip body of its own mass (`α = 1`) and rotary inertia `κ = 0.01` (radius of
 /// gyration 0.1 m) on its rigid tip face: the first natural period is the Euler–Bernoulli
 /// beam's with a tip mass and rotary inertia within 0.5 %. Measured from the free vibration after
-/// a 1 N step load (mean period between upward crossings of the mid-line over seven periods,
-/// `ρ∞ = 1`, 256 steps per period: the scheme's period error is 5e-5): 0.32 % short; bare B1
-/// measured the same way is 0.36 % short of its Euler–Bernoulli period (the hex20 mesh and its
-/// clamped root face are a little stiff). Without the rotary inertia the analytic period would
-/// be 0.88 % shorter, without the tip mass 2.3 times shorter.
+/// a 1 N step load (`ρ∞ = 1`, 256 steps per period: the scheme's period error is 5e-5): 0.32 %
+/// short; bare B1 measured the same way is 0.36 % short of its Euler–Bernoulli period (the hex20
+/// mesh and its clamped root face are a little stiff). Without the rotary inertia the analytic
+/// period would be 0.88 % shorter, without the tip mass 2.3 times shorter.
 #[test]
 fn a_cantilever_with_a_rigid_tip_mass_has_the_analytic_frequency() {
-    let (e, a, l, rho): (f64, f64, f64, f64) = (2.1e11, 0.02, 1.0, 7850.0);
-    let (ei, rho_a) = (e * a.powi(4) / 12.0, rho * a * a);
-    let (alpha, kappa) = (1.0, 0.01);
-    let (mass, j) = (alpha * rho_a * l, kappa * rho_a * l.powi(3));
-    let json = std::fs::read_to_string(format!("{}/examples/cantilever.json", env!("CARGO_MANIFEST_DIR")))
-        .unwrap()
-        .replace(
-            r#""referencePoint": [1.0, 0.0, 0.0] }"#,
-            &format!(
-                r#""referencePoint": [1.0, 0.0, 0.0], "rigid": true, "mass": {mass}, "inertia": [[{j}, 0, 0], [0, {j}, 0], [0, 0, {j}]] }}"#
-            ),
-        )
-        .replace(r#""rhoInf": 0.9"#, r#""rhoInf": 1.0"#);
-    assert!(json.contains(r#""mass""#));
-    let beta = tip_mass_root(alpha, kappa);
-    let omega = beta * beta * (ei / (rho_a * l.powi(4))).sqrt();
-    let period = 2.0 * std::f64::consts::PI / omega;
-    let h = period / 256.0;
-    let mut s = initialized(BodyFile::from_json(&json).unwrap(), &[]);
-    set(&mut s, "tip.force[2]", -1.0);
-    let steps = (8.5 * period / h) as usize;
-    let y: Vec<f64> = (0..steps)
-        .map(|k| {
-            s.do_step(k as f64 * h, h).unwrap();
-            get(&mut s, "tip.position[2]")
-        })
-        .collect();
-    let (lo, hi) = y
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-    let mid = 0.5 * (lo + hi);
-    let crossings: Vec<f64> = (1..steps)
-        .filter(|&k| y[k - 1] < mid && y[k] >= mid)
-        .map(|k| (k as f64 + (mid - y[k - 1]) / (y[k] - y[k - 1])) * h)
-        .collect();
-    let measured = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    let period = tip_body_period(TIP_ALPHA, TIP_KAPPA);
+    let (measured, periods) = measured_period(cantilever_with_tip_body(), &[], period);
     println!(
-        "β = {beta:.6}, period {period:.6e} s (α = 0: {:.6e} s, κ = 0: {:.6e} s); measured {measured:.6e} s over {} periods ({:+.3} %)",
-        2.0 * std::f64::consts::PI / (tip_mass_root(0.0, 0.0).powi(2) * (ei / (rho_a * l.powi(4))).sqrt()),
-        2.0 * std::f64::consts::PI / (tip_mass_root(alpha, 0.0).powi(2) * (ei / (rho_a * l.powi(4))).sqrt()),
-        crossings.len() - 1,
+        "period {period:.6e} s (α = 0: {:.6e} s, κ = 0: {:.6e} s); measured {measured:.6e} s over {periods} periods ({:+.3} %)",
+        tip_body_period(0.0, 0.0),
+        tip_body_period(TIP_ALPHA, 0.0),
         100.0 * (measured / period - 1.0)
     );
-    assert!(crossings.len() >= 8, "{crossings:?}");
+    assert!(periods >= 7, "{periods} periods");
     assert!(
         (measured - period).abs() < 5e-3 * period,
         "{measured} s against {period} s"
     );
-}
-
-/// The controlled arm of `examples/controlled_arm.json` (its hub on the hinge face) with a beam
-/// `stiffer` times stiffer.
-fn arm_with_hub_on_the_hinge_face(stiffer: f64) -> BodyFile {
-    let json = std::fs::read_to_string(format!(
-        "{}/examples/controlled_arm.json",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap()
-    .replace(
-        r#""youngsModulus": 1.68e9"#,
-        &format!(r#""youngsModulus": {}"#, 1.68e9 * stiffer),
-    );
-    BodyFile::from_json(&json).unwrap()
 }
 
 /// A hinge on a rigid set holds the set's centroid and locks its rotation to the axis (two
@@ -319,51 +181,7 @@ fn arm_with_hub_on_the_hinge_face(stiffer: f64) -> BodyFile {
 /// 1 %, while the hub turns about no other axis than z.
 #[test]
 fn a_hinge_on_a_rigid_set_locks_it_to_its_axis() {
-    // The torque is set in initialization mode, so that the initial acceleration carries it (a
-    // jump at the first step would cost generalized-α (1 − γ) h of the acceleration's time: 0.45 %).
-    let (torque, h) = (100.0, 5e-3);
-    let mut s = initialized(
-        arm_with_hub_on_the_hinge_face(1e4),
-        &[("damping.beta", 2e-3), ("hub.torque[3]", torque)],
-    );
-    for k in 0..100 {
-        s.do_step(k as f64 * h, h).unwrap();
-    }
-    let r = |s: &mut Slave| {
-        nalgebra::Matrix3::from_fn(|i, j| get(s, &format!("hub.rotation[{}]", 3 * i + j + 1)))
-    };
-    let q = r(&mut s);
-    let angle = q[(1, 0)].atan2(q[(0, 0)]);
-    let expected = 0.5 * torque / 500.0 * 0.5_f64.powi(2);
-    println!(
-        "angle {angle:.6e} rad against {expected:.6e} rad; tilt {:.3e}",
-        q[(2, 2)] - 1.0
-    );
-    assert!(
-        (angle - expected).abs() < 5e-3 * expected,
-        "{angle} rad against {expected} rad"
-    );
-    // Out of the plane: the bearing carries the moment of a load along z.
-    let mut s = initialized(
-        arm_with_hub_on_the_hinge_face(1e4),
-        &[("damping.beta", 2e-3)],
-    );
-    set(&mut s, "tip.force[3]", 1.0);
-    for k in 0..200 {
-        s.do_step(k as f64 * h, h).unwrap();
-    }
-    let moment = vector(&mut s, "bearing.torque");
-    let q = r(&mut s);
-    println!(
-        "bearing moment {moment:?}; hub rotation about x, y: {:.3e} {:.3e}",
-        q[(2, 1)],
-        q[(0, 2)]
-    );
-    assert!(
-        (moment.y - 10.0).abs() < 0.01 * 10.0 && moment.x.abs() < 1e-3 && moment.z.abs() < 1e-3,
-        "{moment:?}"
-    );
-    assert!(q[(2, 1)].abs() < 1e-9 && q[(0, 2)].abs() < 1e-9);
+    hinge_on_a_rigid_set(&[]);
 }
 
 /// The driven cantilever (root clamped to the motion interface `root`) with or without a lumped
@@ -452,34 +270,7 @@ fn two_pins_on_a_rigid_set_are_refused_by_name() {
 /// stepped on continues bit for bit.
 #[test]
 fn a_saved_state_with_rigid_sets_and_a_lumped_body_continues_bit_for_bit() {
-    let arm = || example_body("controlled_arm");
-    let mut s = initialized(arm(), &[("hub.torque[3]", 50.0)]);
-    let h = 0.01;
-    for k in 0..20 {
-        s.do_step(k as f64 * h, h).unwrap();
-    }
-    let saved = s.get_state();
-    let mut bytes = Vec::new();
-    saved.write_bytes(&mut bytes);
-    let run_on = |s: &mut Slave| -> Vec<f64> {
-        (20..40)
-            .flat_map(|k| {
-                s.do_step(k as f64 * h, h).unwrap();
-                let tip = vector(s, "tip.position");
-                [
-                    tip.x,
-                    tip.y,
-                    get(s, "bearing.force[1]"),
-                    get(s, "bearing.torque[3]"),
-                ]
-            })
-            .collect()
-    };
-    let expected = run_on(&mut s);
-    let mut fresh = initialized(arm(), &[]);
-    let restored = fresh.state_from_bytes(&bytes).unwrap();
-    fresh.set_state(&restored).unwrap();
-    assert_eq!(run_on(&mut fresh), expected);
+    saved_arm_continues(&[]);
 }
 
 /// The tip's y after 0.6 s under a tip torque about z ramped to `torque` in 0.1 s (damping

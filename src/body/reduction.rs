@@ -47,6 +47,16 @@
 //! otherwise). Their coefficients are the set's motion: driven by a frame `(p, Q)`,
 //! `q_0 = p + Q (X_cs − X_ref)` and `q_a = Q t_a` ([`HeldCoordinate`]), so a motion interface or
 //! fixed support holds `a_j` coordinates exactly as it holds nodes on the full mesh.
+//!
+//! A rigid attachment (docs/formulation.md, "Rigid attachments", "The reduced body") is a
+//! boundary set too, held in the static solves like a support, with its constraint modes and
+//! without attachment modes (a load on a boundary set moves only its affine coordinates, whose
+//! static responses the constraint modes are). Its held fields are made barycentric:
+//! `φ_0 = 1 − Σ_a t_a · (X − X_cs)`, `φ_a = t_a · (X − X_cs)`, whose coefficients are points,
+//! `P_0` at `X_cs` and `P_a` at `X_cs + t_a` (`x_i = Σ_b φ_b(X_i) P_b` on the set, `Σ_b φ_b = 1`).
+//! The set moves rigidly exactly when these 3 or 4 points do, which the solver holds with the
+//! mesh's rigid-set constraint over them ([`Reduction::rigid`]). A lumped body's mass points
+//! belong to the set, so their mass enters `Sᵀ Ms S` through the set's affine fields.
 
 use super::frame::{node, FrameWeights};
 use super::interface::{FieldBasis, HeldCoordinate, NodeSet};
@@ -56,9 +66,9 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 mod construction;
 use construction::{
-    attachment_modes, basis_fields, boundary_coefficients, candidate_fields, constraint_modes,
-    expanded_frame, fixed_interface_modes, held_coordinates, reduced_mass, reduced_stiffness,
-    InteriorSolve,
+    attachment_modes, barycentric_fields, basis_fields, boundary_coefficients, candidate_fields,
+    constraint_modes, expanded_frame, fixed_interface_modes, held_coordinates, reduced_mass,
+    reduced_stiffness, InteriorSolve,
 };
 
 /// Scalar fields from a vector mode whose mass norm is below this fraction of the mode's
@@ -145,28 +155,63 @@ pub struct Reduction {
     pub stiffness_matrix: SymmetricCsr,
     /// The co-moving frame of the expanded nodes (HRZ-lumped weights) in terms of `q`.
     pub frame_weights: FrameWeights,
-    /// Per boundary set (in the order given to [`Reduction::new`]): its held coordinates.
+    /// Per held set (`InterfaceSets::held`, in order): its held coordinates.
     pub held: Vec<Vec<HeldCoordinate>>,
+    /// Per rigid set (`InterfaceSets::rigid`, in order): its barycentric fields, whose
+    /// coefficients are points at the reference positions `reference` of these fields (see the
+    /// module documentation).
+    pub rigid: Vec<Vec<usize>>,
     /// `ω²` of the fixed-interface (or free-free elastic) modes in the basis (1/s²).
     pub mode_eigenvalues: Vec<f64>,
     /// How the mode count was chosen ([`ModeCount::Accuracy`]; `None` for a given count).
     pub mode_choice: Option<ModeChoice>,
 }
 
+/// The mesh data a reduction starts from (`N` nodes: the mesh's, then any lumped body's mass
+/// points).
+#[derive(Debug, Clone, Copy)]
+pub struct MeshData<'a> {
+    /// Reference positions `X` (flat `3N`, m).
+    pub reference: &'a [f64],
+    /// `Ms`, the scalar consistent mass matrix (kg), `N × N`.
+    pub mass: &'a SymmetricCsr,
+    /// `K` (N/m), `3N × 3N`: the static solves and modes.
+    pub stiffness: &'a SymmetricCsr,
+    /// The elastic force's `K`, if it differs from `stiffness` (without the elements wholly
+    /// inside rigid sets, docs/formulation.md "Rigid attachments"): `K_r` is projected from it.
+    pub force_stiffness: Option<&'a SymmetricCsr>,
+    /// HRZ-lumped masses (kg): the inertial loads of the mode choice, inertia relief.
+    pub lumped: &'a [f64],
+    /// The co-moving frame's weights per node (the lumped masses, zero on mass points).
+    pub frame_weights: &'a [f64],
+}
+
+/// The interfaces' node sets as the reduction treats them.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InterfaceSets<'a> {
+    /// Fixed supports and motion interfaces: boundary sets whose coordinates are held.
+    pub held: &'a [&'a NodeSet],
+    /// Rigid attachments: boundary sets that move as one rigid body (see the module
+    /// documentation).
+    pub rigid: &'a [&'a NodeSet],
+    /// Force interfaces that are not rigid: their attachment modes.
+    pub loaded: &'a [&'a NodeSet],
+}
+
 impl Reduction {
-    /// The basis of the module documentation for the mesh data (`reference` flat `3N`, `Ms`,
-    /// `K`, HRZ `lumped` masses), boundary sets `boundary` (fixed supports and motion
-    /// interfaces), force interfaces `loaded` and `modes` fixed-interface modes (a count ≥ 1, or
-    /// the fewest that meet an accuracy, [`ModeChoice`]).
-    pub fn new(
-        reference: &[f64],
-        mass: &SymmetricCsr,
-        stiffness: &SymmetricCsr,
-        lumped: &[f64],
-        boundary: &[&NodeSet],
-        loaded: &[&NodeSet],
-        modes: ModeCount,
-    ) -> Result<Reduction> {
+    /// The basis of the module documentation for the mesh data, the interfaces' sets and
+    /// `modes` fixed-interface modes (a count ≥ 1, or the fewest that meet an accuracy,
+    /// [`ModeChoice`]).
+    pub fn new(mesh: &MeshData, sets: &InterfaceSets, modes: ModeCount) -> Result<Reduction> {
+        let MeshData {
+            reference,
+            mass,
+            stiffness,
+            lumped,
+            ..
+        } = *mesh;
+        let boundary: Vec<&NodeSet> = sets.held.iter().chain(sets.rigid).copied().collect();
+        let (boundary, loaded) = (&boundary[..], sets.loaded);
         let n = lumped.len();
         let fewest = match modes {
             ModeCount::Fixed(count) => count,
@@ -181,13 +226,20 @@ impl Reduction {
         attachment_modes(&mut solve, reference, lumped, loaded, &mut vectors);
         let candidates = candidate_fields(&vectors, mass, reference, n);
         let coefficients = boundary_coefficients(&candidates, boundary, &set_functions, reference)?;
-        let (fields, held_count) = basis_fields(&coefficients, &candidates, mass, n)?;
+        let (mut fields, held_count) = basis_fields(&coefficients, &candidates, mass, n)?;
+        let rigid = barycentric_fields(&mut fields, &set_functions, sets.held.len());
         let s = fields.len();
         let (gram, unit, reduced_reference, row_major) = reduced_mass(&fields, mass, reference, n)?;
-        let stiffness_r = reduced_stiffness(&fields, stiffness, n);
-        let frame_weights =
-            expanded_frame(lumped, reference, &row_major, &reduced_reference, &unit);
-        let held = held_coordinates(boundary, &set_functions, &reduced_reference, held_count);
+        let stiffness_r = reduced_stiffness(&fields, mesh.force_stiffness.unwrap_or(stiffness), n);
+        let frame_weights = expanded_frame(
+            mesh.frame_weights,
+            reference,
+            &row_major,
+            &reduced_reference,
+            &unit,
+        );
+        let mut held = held_coordinates(boundary, &set_functions, &reduced_reference, held_count);
+        held.truncate(sets.held.len());
         Ok(Reduction {
             node_count: n,
             field_count: s,
@@ -199,6 +251,7 @@ impl Reduction {
             stiffness_matrix: dense_symmetric(&stiffness_r),
             frame_weights,
             held,
+            rigid,
             mode_eigenvalues,
             mode_choice,
         })
@@ -207,6 +260,24 @@ impl Reduction {
     /// Row `S_i·` of node `i`.
     pub fn row(&self, i: usize) -> &[f64] {
         &self.fields[i * self.field_count..(i + 1) * self.field_count]
+    }
+
+    /// The weighted centroid `Σ w_i x_i / W` of the mesh nodes `nodes` (weights `weights`) as
+    /// fields and weights: `Σ_k c_k q_k / Σ_k c_k` with `c_k = Σ_i w_i S_ik` (fields whose `c_k`
+    /// is below 1e-12 of the largest, round-off on a set where they vanish, are left out). On a
+    /// boundary set the fields' sum is 1 there, so `Σ_k c_k = W`.
+    pub fn centroid_weights(&self, nodes: &[usize], weights: &[f64]) -> (Vec<usize>, Vec<f64>) {
+        let mut c = vec![0.0; self.field_count];
+        for (&i, &w) in nodes.iter().zip(weights) {
+            c.iter_mut()
+                .zip(self.row(i))
+                .for_each(|(ck, &s)| *ck += w * s);
+        }
+        let largest = c.iter().fold(0.0, |a: f64, &b| a.max(b.abs()));
+        (0..self.field_count)
+            .filter(|&k| c[k].abs() > 1e-12 * largest)
+            .map(|k| (k, c[k]))
+            .unzip()
     }
 
     /// The basis as a node set needs it ([`NodeSet::set_reduction`]).

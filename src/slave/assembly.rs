@@ -7,7 +7,9 @@ use crate::body::feature_indicators::FeatureIndicators;
 use crate::body::lowest_modes::LowestModes;
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
-use crate::body::{Body, BodyOptions, ModeCount, NodeSet, Patches, Reduction};
+use crate::body::{
+    Body, BodyOptions, InterfaceSets, MeshData, ModeCount, NodeSet, Patches, Reduction,
+};
 use crate::error::{Error, Result};
 use crate::fem::nonlinear::SvkSolid;
 use crate::fem::{self, IsotropicMaterial};
@@ -194,6 +196,22 @@ impl Slave {
         self.finish_model(key, body, clamped, &lumped)
     }
 
+    /// For each interface, whether it is a rigid attachment (a force interface, pin or hinge
+    /// with `"rigid": true`).
+    fn rigid_attachments(&self) -> Vec<bool> {
+        self.interfaces
+            .iter()
+            .zip(&self.body_file.interfaces)
+            .map(|(i, spec)| {
+                spec.rigid
+                    && matches!(
+                        i.kind,
+                        InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                    )
+            })
+            .collect()
+    }
+
     /// For each element, whether all its nodes belong to one rigid set (of a force interface,
     /// pin or hinge with `"rigid": true`).
     fn elements_inside_rigid_sets(&self) -> Vec<bool> {
@@ -285,20 +303,44 @@ impl Slave {
         self.check_reducible()?;
         let p = &self.parameters;
         let started = std::time::Instant::now();
-        let sets = |kinds: &[InterfaceKind]| {
+        // Rigid attachments are boundary sets of their own (body::reduction).
+        let rigid = self.rigid_attachments();
+        let sets = |held: bool, want_rigid: bool| {
             self.interfaces
                 .iter()
-                .filter(|i| kinds.contains(&i.kind))
-                .map(|i| &i.set)
+                .zip(&rigid)
+                .filter(|(i, &r)| {
+                    if held {
+                        matches!(i.kind, InterfaceKind::Fixed | InterfaceKind::Motion)
+                    } else if want_rigid {
+                        r
+                    } else {
+                        i.kind == InterfaceKind::Force && !r
+                    }
+                })
+                .map(|(i, _)| &i.set)
                 .collect::<Vec<&NodeSet>>()
         };
+        // The co-moving frame fits the mesh's nodes: a lumped body's mass points weigh nothing
+        // in it (as on the mesh body).
+        let mesh_nodes = self.mesh.node_count();
+        let frame_weights: Vec<f64> = (0..lumped.len())
+            .map(|i| if i < mesh_nodes { lumped[i] } else { 0.0 })
+            .collect();
         let reduction = Reduction::new(
-            &matrices.reference,
-            &matrices.mass_matrix,
-            &matrices.stiffness_matrix,
-            lumped,
-            &sets(&[InterfaceKind::Fixed, InterfaceKind::Motion]),
-            &sets(&[InterfaceKind::Force]),
+            &MeshData {
+                reference: &matrices.reference,
+                mass: &matrices.mass_matrix,
+                stiffness: &matrices.stiffness_matrix,
+                force_stiffness: matrices.force_stiffness.as_ref(),
+                lumped,
+                frame_weights: &frame_weights,
+            },
+            &InterfaceSets {
+                held: &sets(true, false),
+                rigid: &sets(false, true),
+                loaded: &sets(false, false),
+            },
             modes,
         )?;
         if let Some(choice) = &reduction.mode_choice {
@@ -499,37 +541,41 @@ impl Slave {
     /// point constraints start.
     fn constrained_free_nodes(&mut self, body: &Body, clamped: &[bool]) -> Result<FreeNodes> {
         let mut free = FreeNodes::new(body, clamped);
-        for (interface, spec) in self.interfaces.iter().zip(&self.body_file.interfaces) {
-            if spec.rigid
-                && matches!(
-                    spec.kind,
-                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
-                )
-            {
+        // On a reduced body a rigid set's nodes are its barycentric fields (body::reduction),
+        // the `j`-th rigid attachment's `reduction.rigid[j]`.
+        let rigid = self.rigid_attachments();
+        let set_nodes: Vec<Vec<usize>> = (0..self.interfaces.len())
+            .map(|k| match &body.reduction {
+                Some(reduction) if rigid[k] => {
+                    reduction.rigid[rigid[..k].iter().filter(|&&r| r).count()].clone()
+                }
+                _ => self.interfaces[k].set.frame_weights.nodes.clone(),
+            })
+            .collect();
+        for (k, spec) in self.body_file.interfaces.iter().enumerate() {
+            if rigid[k] {
                 if self.parameters.formulation == Formulation::Full {
                     return Err(Error::new(format!(
                         "interface '{}': rigid attachments are not available with model.formulation = full (its Newton iteration works in the global frame); use reducedStrain",
                         spec.name
                     )));
                 }
-                free.add_rigid_set(
-                    &spec.name,
-                    &interface.set.frame_weights.nodes,
-                    &body.reference,
-                )?;
+                free.add_rigid_set(&spec.name, &set_nodes[k], &body.reference)?;
             }
         }
         self.check_held_points_on_rigid_sets()?;
         for (k, interface) in self.interfaces.iter_mut().enumerate() {
             interface.first_constraint = free.constraints.len();
             for (nodes, weights) in &interface.point_constraints {
+                let name = &self.body_file.interfaces[k].name;
                 // The target is set where the body is placed (ensure_initial_state).
-                free.add_point_constraint(
-                    &self.body_file.interfaces[k].name,
-                    nodes,
-                    weights,
-                    Vector3::zeros(),
-                )?;
+                match &body.reduction {
+                    Some(reduction) => {
+                        let (fields, weights) = reduction.centroid_weights(nodes, weights);
+                        free.add_point_constraint(name, &fields, &weights, Vector3::zeros())?
+                    }
+                    None => free.add_point_constraint(name, nodes, weights, Vector3::zeros())?,
+                }
             }
         }
         for k in 0..self.interfaces.len() {
@@ -538,7 +584,7 @@ impl Slave {
                 self.interfaces[k].lock_constraint = free.rigid.len();
                 free.add_axis_lock(
                     &spec.name,
-                    &self.interfaces[rigid].set.frame_weights.nodes,
+                    &set_nodes[rigid],
                     &body.reference,
                     Vector3::from(spec.axis.unwrap_or_default()),
                 )?;

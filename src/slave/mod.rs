@@ -528,11 +528,14 @@ impl Slave {
         self.rejected = state.counters[3];
         if let Some(d) = &state.dynamics {
             self.ensure_model()?;
-            let expected = 3 * self.model.as_ref().unwrap().body.node_count();
-            if d.state.position.len() != expected {
+            let model = self.model.as_ref().unwrap();
+            let expected = 3 * model.body.node_count();
+            let multipliers = model.free.multiplier_count();
+            if d.state.position.len() != expected || d.state.multipliers.len() != multipliers {
                 return Err(Error::new(format!(
-                    "the FMU state has {} coordinates, this body (model.modes = {}) has {expected}: it belongs to another body",
+                    "the FMU state has {} coordinates and {} constraint multipliers, this body (model.modes = {}) has {expected} and {multipliers}: it belongs to another body",
                     d.state.position.len(),
+                    d.state.multipliers.len(),
                     self.parameters.modes
                 )));
             }

@@ -377,8 +377,22 @@ impl Slave {
                 ]) {
                     r.f64s(v, what)?;
                 }
-                let multipliers = self.multiplier_count();
-                r.count(multipliers, "constraint multipliers")?;
+                let multipliers = if p.modes == 0 {
+                    let multipliers = self.multiplier_count();
+                    r.count(multipliers, "constraint multipliers")?;
+                    multipliers
+                } else {
+                    // A reduced body's rigid sets are 3 or 4 points each, fewer rows than on the
+                    // mesh; `set_state` checks the count against the model it builds.
+                    let m = r.u64("constraint multipliers")?;
+                    if m > self.multiplier_count() as u64 {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state has {m} constraint multipliers, more than this body's {} on its mesh: it belongs to another body",
+                            self.multiplier_count()
+                        )));
+                    }
+                    m as usize
+                };
                 let mut lambda = vec![0.0; multipliers];
                 r.f64s(&mut lambda, "the constraint multipliers")?;
                 let mut loads: Vec<Inputs> = vec![[0.0; INTERFACE_SLOTS]; n];

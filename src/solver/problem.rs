@@ -45,7 +45,15 @@ pub struct FreeNodes {
     pub elastic_nodes: usize,
     /// `Body::modal_stiffness` restricted to the free DOFs, if the body has one.
     modal_stiffness: Option<SymmetricCsr>,
+    /// Whether [`Self::elastic_matrices`] holds the rigid sets (a reduced body).
+    rigid_sets_in_modes: bool,
 }
+
+/// The penalty of a reduced body's rigid sets in its modal analysis, relative to the largest
+/// diagonal entry of `K` ([`FreeNodes::elastic_matrices`]): the sets' deformations then lie
+/// 10³ times above the highest frequency of `K` alone, and the lowest modes hold the sets rigid
+/// to about 1e-6 of their motion.
+pub const RIGID_SET_PENALTY: f64 = 1e6;
 
 impl FreeNodes {
     /// Free nodes of `body` when `clamped` nodes are held.
@@ -68,14 +76,37 @@ impl FreeNodes {
             rigid: Vec::new(),
             elastic_nodes,
             modal_stiffness,
+            rigid_sets_in_modes: body.reduction.is_some(),
         }
     }
 
     /// `K` and `M ⊗ I3` on the free mesh nodes' DOFs (without the lumped bodies' mass points,
     /// whose zero stiffness would add zero frequencies, and with the elements inside rigid sets,
     /// whose constraints a modal analysis does not see): what a modal analysis of the elastic
-    /// body takes.
+    /// body takes. On a reduced body the rigid sets are in it as a penalty,
+    /// `K + κ Σ V Vᵀ` with `κ` [`RIGID_SET_PENALTY`] times `K`'s largest diagonal entry and `V`
+    /// the sets' shape constraints at the reference (a rigid set's fourth point may carry only
+    /// mass points, which gives `K` a null space there: body::reduction).
     pub fn elastic_matrices(&self) -> (SymmetricCsr, SymmetricCsr) {
+        if self.rigid_sets_in_modes && !self.rigid.is_empty() {
+            let k = &self.stiffness;
+            let largest = k.diagonal().iter().fold(0.0, |a: f64, &b| a.max(b));
+            let mut triplets = Vec::new();
+            for set in self.rigid.iter().filter(|s| s.lock.is_none()) {
+                let rows: Vec<usize> = set.free_rows.iter().flat_map(|&r| r..r + 3).collect();
+                for v in set.basis.chunks(rows.len()) {
+                    for (a, &ra) in rows.iter().enumerate() {
+                        for (b, &rb) in rows.iter().enumerate() {
+                            triplets.push((ra, rb, v[a] * v[b]));
+                        }
+                    }
+                }
+            }
+            let penalty = SymmetricCsr::from_triplets(k.n, &triplets);
+            let penalised =
+                SymmetricCsr::linear_combination(1.0, k, RIGID_SET_PENALTY * largest, &penalty);
+            return (penalised, self.mass.clone());
+        }
         let stiffness = self.modal_stiffness.as_ref().unwrap_or(&self.stiffness);
         let dofs: Vec<usize> = (0..3 * self.elastic_nodes).collect();
         if dofs.len() == stiffness.n {

@@ -637,6 +637,34 @@ pub(super) fn expanded_frame(
     )
 }
 
+/// Makes the held fields of the rigid sets (the boundary sets from `first_rigid` on)
+/// barycentric: `φ_0 = f_0 − Σ_a f_a` in place of the field `f_0` that is 1 on the set, the
+/// fields `f_a = t_a · (X − X_cs)` kept (module documentation of `reduction`: a rigid set's
+/// coefficients are then points). Returns each rigid set's field indices.
+pub(super) fn barycentric_fields(
+    fields: &mut [Vec<f64>],
+    set_functions: &[SetFunctions],
+    first_rigid: usize,
+) -> Vec<Vec<usize>> {
+    let mut index = 0;
+    let mut rigid = Vec::new();
+    for (j, (_, directions)) in set_functions.iter().enumerate() {
+        let a = directions.len();
+        if j >= first_rigid {
+            for b in 1..=a {
+                let (head, tail) = fields.split_at_mut(index + b);
+                head[index]
+                    .iter_mut()
+                    .zip(&tail[0])
+                    .for_each(|(f0, fb)| *f0 -= fb);
+            }
+            rigid.push((index..=index + a).collect());
+        }
+        index += 1 + a;
+    }
+    rigid
+}
+
 /// The coordinates each boundary set holds: the first `a_j` held fields belong to set `j`.
 pub(super) fn held_coordinates(
     boundary: &[&NodeSet],

@@ -12,9 +12,7 @@ impl Slave {
     /// no stiffening: anything else is an error naming the interface and what is not supported.
     pub(super) fn check_mass_points(&self) -> Result<()> {
         let p = &self.parameters;
-        let unsupported = if p.mode_count().is_some() {
-            Some("a reduced body (model.modes ≠ 0)")
-        } else if p.formulation == Formulation::Full {
+        let unsupported = if p.formulation == Formulation::Full {
             Some("model.formulation = full")
         } else if p.stiffening != Stiffening::None {
             Some("model.stiffening other than none (the mass points carry no stress)")
@@ -66,7 +64,8 @@ impl Slave {
     }
 
     /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
-    /// stiffening, pins or hinges; anything else is an error naming the parameter.
+    /// stiffening, with pins and hinges on rigid sets only; anything else is an error naming the
+    /// parameter.
     pub(in crate::slave) fn check_reducible(&self) -> Result<()> {
         let p = &self.parameters;
         let reason = if p.formulation == Formulation::Full {
@@ -90,25 +89,36 @@ impl Slave {
         } else if p.integrator == Integrator::CentralDifference {
             Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
         } else {
+            // A pin or hinge holds a point of a rigid set (its own, or another's on the same
+            // nodes): a boundary set of the basis, whose points the constraint holds exactly.
+            let specs = &self.body_file.interfaces;
+            let rigid_sets: Vec<&[usize]> = self
+                .interfaces
+                .iter()
+                .zip(specs)
+                .filter(|(i, spec)| {
+                    spec.rigid
+                        && matches!(
+                            i.kind,
+                            InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
+                        )
+                })
+                .map(|(i, _)| &i.set.frame_weights.nodes[..])
+                .collect();
             self.interfaces
                 .iter()
-                .zip(&self.body_file.interfaces)
-                .find(|(i, spec)| {
+                .zip(specs)
+                .find(|(i, _)| {
                     matches!(i.kind, InterfaceKind::Pin | InterfaceKind::Hinge)
-                        || (spec.rigid && i.kind == InterfaceKind::Force)
+                        && !rigid_sets.iter().any(|set| {
+                            i.set.frame_weights.nodes.iter().all(|n| set.contains(n))
+                        })
                 })
                 .map(|(i, spec)| {
-                    if i.kind == InterfaceKind::Force {
-                        format!(
-                            "interface '{}' is a rigid force interface: rigid attachments are not available on a reduced body yet (use the mesh body, model.modes = 0)",
-                            spec.name
-                        )
-                    } else {
-                        format!(
-                            "interface '{}' is a {:?} support: pins and hinges are not available on a reduced body (use a fixed support or a motion interface)",
-                            spec.name, i.kind
-                        )
-                    }
+                    format!(
+                        "interface '{}' is a {:?} support on nodes that are not a rigid set: a pin or hinge on a reduced body must be rigid (\"rigid\": true) or sit on a rigid attachment's nodes; otherwise use a fixed support, a motion interface or the mesh body (model.modes = 0)",
+                        spec.name, i.kind
+                    )
                 })
         };
         match reason {
