@@ -258,6 +258,53 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     assert_eq!(s.controlled_step_size(), 0.5 * h);
 }
 
+/// A body whose every communication step is one internal step from an input jump has nothing
+/// estimated (docs/formulation.md, "Time error control"), and says so: B1 at
+/// `solver.stepSize` = H = 1 ms with its tip load changed at every step warns once, at the 10th
+/// step (`UNESTIMATED_WARN_AFTER`), and the run summary counts the steps; the same load held is
+/// estimated from the second step on and nothing is said.
+#[test]
+fn steps_that_cannot_be_estimated_are_named() {
+    let run = |changing: bool| {
+        let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+        s.setup_experiment(0.0, None, None).unwrap();
+        s.enter_initialization_mode().unwrap();
+        s.set_by_name("solver.stepSize", 1e-3).unwrap();
+        s.set_by_name("model.accuracy", 1e-3).unwrap();
+        s.exit_initialization_mode().unwrap();
+        let force = vr(&s, "tip.force[2]");
+        let h = 1e-3;
+        let mut warnings = Vec::new();
+        for k in 0..30 {
+            if changing || k == 0 {
+                s.set_real(force, -10.0 - 0.1 * k as f64).unwrap();
+            }
+            s.do_step(k as f64 * h, h).unwrap();
+            for e in s.drain_events() {
+                if e.message.contains("were not estimated") {
+                    warnings.push((k, e.message.clone()));
+                }
+            }
+        }
+        s.terminate();
+        let summary = s
+            .drain_events()
+            .find(|e| e.message.starts_with("run summary"))
+            .unwrap()
+            .message;
+        (warnings, summary)
+    };
+    let (warnings, summary) = run(true);
+    println!("{warnings:?}\n{summary}");
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert_eq!(warnings[0].0, 9, "{warnings:?}");
+    assert!(summary.contains("30 not estimated"), "{summary}");
+    let (warnings, summary) = run(false);
+    println!("{summary}");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(summary.contains(", 1 not estimated"), "{summary}");
+}
+
 /// A load on a few nodes along a stiff direction (docs/formulation.md, "Time error control": the
 /// deformation scale): B1's coarse beam pulled along its axis by 10 kN at the tip, damped
 /// (β = 1e-5 s: the axial mode, 1.3 kHz, loses half its amplitude in ~8 periods). The tip's

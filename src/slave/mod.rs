@@ -175,6 +175,10 @@ pub struct Slave {
     /// Communication steps redone with finer internal steps because the error estimate exceeded
     /// the accuracy ([`step_control`]).
     rejected: u64,
+    /// Communication steps whose error nothing estimated (one internal step from an input
+    /// jump, `step_control::UNESTIMATED_WARN_AFTER`): in all, in a row, and whether the body
+    /// has warned of them.
+    unestimated: (u64, u32, bool),
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
@@ -278,6 +282,7 @@ impl Slave {
             statistics: (0, 0),
             retries: 0,
             rejected: 0,
+            unestimated: (0, 0, false),
             step_error: None,
             step_estimate: 0.0,
             inputs_jumped: false,
@@ -454,11 +459,12 @@ impl Slave {
         self.events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "run summary: {steps} internal steps, {iterations} fixed-point iterations ({:.2} per step), {} internal steps retried with halved steps, {} communication steps redone on a finer rung by the error control (model.accuracy = {:e}); last internal step at most {:e} s",
+                "run summary: {steps} internal steps, {iterations} fixed-point iterations ({:.2} per step), {} internal steps retried with halved steps, {} communication steps redone on a finer rung by the error control (model.accuracy = {:e}), {} not estimated (one internal step from an input jump); last internal step at most {:e} s",
                 iterations as f64 / steps.max(1) as f64,
                 self.retries,
                 self.rejected,
                 self.parameters.accuracy,
+                self.unestimated.0,
                 self.controlled_step_size()
             ),
         });
@@ -482,6 +488,7 @@ impl Slave {
         self.statistics = (0, 0);
         self.retries = 0;
         self.rejected = 0;
+        self.unestimated = (0, 0, false);
         self.outputs.valid = false;
         self.results = None;
     }

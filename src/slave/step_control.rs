@@ -78,6 +78,13 @@ pub const PROBE_LAST: u32 = 256;
 /// coarser rung), one that does not fall with `h` below 1/2.
 pub const PROBE_BELOW: f64 = 0.5;
 
+/// Communication steps in a row that nothing estimated (each one internal step that starts at
+/// an input jump: docs/formulation.md, "Time error control") before the body warns, once, that
+/// their time error is not controlled. A single jump (a step load) passes unremarked; inputs
+/// that jump at every communication point with `solver.stepSize` at or above the communication
+/// step (a driven body sampled by its importer: B3) are named within the first 10 steps.
+pub const UNESTIMATED_WARN_AFTER: u32 = 10;
+
 /// Where the internal step stands on the ladder between communication steps (part of the FMU
 /// state).
 #[derive(Debug, Clone, Copy, PartialEq)]
