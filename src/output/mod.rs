@@ -100,11 +100,11 @@ impl ResultWriter {
         let centroid = body.frame_weights.reference_centroid;
         // The mesh's nodes: a lumped body's mass points (after them) are not drawn.
         let (expanded, reference) = match &body.reduction {
-            Some(r) => ((r.expand(x), r.expand(v)), &r.mesh_reference[..]),
+            Some(r) => ((r.expand(x), r.expand(v)), &r.mesh_reference[..3 * n]),
             None => ((Vec::new(), Vec::new()), &body.reference[..3 * n]),
         };
         let (x, v) = match &body.reduction {
-            Some(_) => (&expanded.0[..], &expanded.1[..]),
+            Some(_) => (&expanded.0[..3 * n], &expanded.1[..3 * n]),
             None => (&x[..3 * n], &v[..3 * n]),
         };
         let displacement: Vec<f64> = x.iter().zip(reference).map(|(a, b)| a - b).collect();

@@ -301,6 +301,11 @@ impl Slave {
         modes: ModeCount,
     ) -> Result<(Body, Vec<bool>)> {
         self.check_reducible()?;
+        // The sets' loads and motions are the mesh's while the basis is built (its attachment
+        // modes distribute unit loads over the nodes), not a previous reduction's.
+        for interface in &mut self.interfaces {
+            interface.set.set_reduction(None);
+        }
         let p = &self.parameters;
         let started = std::time::Instant::now();
         // Rigid attachments are boundary sets of their own (body::reduction).
@@ -369,7 +374,7 @@ impl Slave {
             message: format!(
                 "reduced the body (model.modes = {}): {} nodes → {} fields ({} coordinates); fixed-interface mode frequencies [{}] Hz ({:.3} s)",
                 p.modes,
-                reduction.node_count,
+                self.mesh.node_count(),
                 reduction.field_count,
                 3 * reduction.field_count,
                 frequencies.join(", "),

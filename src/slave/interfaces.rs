@@ -237,8 +237,9 @@ pub(super) fn extrapolate(input: &mut Inputs, d: &InputDerivatives, tau: f64) {
 }
 
 impl Slave {
-    /// The Lagrange multipliers of the interfaces: 3 per point constraint of a pin or hinge,
-    /// `3n − 6` per rigid set of `n` nodes (`FreeNodes::multiplier_count` of any model built).
+    /// The Lagrange multipliers of the interfaces on the mesh body: 3 per point constraint of a
+    /// pin or hinge, `3n − 6` per rigid set of `n` nodes (`FreeNodes::multiplier_count` of a mesh
+    /// body; a reduced body's rigid sets have 3 or 4 points, and fewer rows).
     pub(super) fn multiplier_count(&self) -> usize {
         self.interfaces
             .iter()

@@ -45,15 +45,10 @@ pub struct FreeNodes {
     pub elastic_nodes: usize,
     /// `Body::modal_stiffness` restricted to the free DOFs, if the body has one.
     modal_stiffness: Option<SymmetricCsr>,
-    /// Whether [`Self::elastic_matrices`] holds the rigid sets (a reduced body).
+    /// Whether a modal analysis holds the rigid sets ([`Self::rigid_set_motions`]: a reduced
+    /// body).
     rigid_sets_in_modes: bool,
 }
-
-/// The penalty of a reduced body's rigid sets in its modal analysis, relative to the largest
-/// diagonal entry of `K` ([`FreeNodes::elastic_matrices`]): the sets' deformations then lie
-/// 10³ times above the highest frequency of `K` alone, and the lowest modes hold the sets rigid
-/// to about 1e-6 of their motion.
-pub const RIGID_SET_PENALTY: f64 = 1e6;
 
 impl FreeNodes {
     /// Free nodes of `body` when `clamped` nodes are held.
@@ -83,36 +78,54 @@ impl FreeNodes {
     /// `K` and `M ⊗ I3` on the free mesh nodes' DOFs (without the lumped bodies' mass points,
     /// whose zero stiffness would add zero frequencies, and with the elements inside rigid sets,
     /// whose constraints a modal analysis does not see): what a modal analysis of the elastic
-    /// body takes. On a reduced body the rigid sets are in it as a penalty,
-    /// `K + κ Σ V Vᵀ` with `κ` [`RIGID_SET_PENALTY`] times `K`'s largest diagonal entry and `V`
-    /// the sets' shape constraints at the reference (a rigid set's fourth point may carry only
-    /// mass points, which gives `K` a null space there: body::reduction).
+    /// body takes (on a reduced body with rigid sets, in the coordinates of
+    /// [`Self::rigid_set_motions`]).
     pub fn elastic_matrices(&self) -> (SymmetricCsr, SymmetricCsr) {
-        if self.rigid_sets_in_modes && !self.rigid.is_empty() {
-            let k = &self.stiffness;
-            let largest = k.diagonal().iter().fold(0.0, |a: f64, &b| a.max(b));
-            let mut triplets = Vec::new();
-            for set in self.rigid.iter().filter(|s| s.lock.is_none()) {
-                let rows: Vec<usize> = set.free_rows.iter().flat_map(|&r| r..r + 3).collect();
-                for v in set.basis.chunks(rows.len()) {
-                    for (a, &ra) in rows.iter().enumerate() {
-                        for (b, &rb) in rows.iter().enumerate() {
-                            triplets.push((ra, rb, v[a] * v[b]));
-                        }
-                    }
-                }
-            }
-            let penalty = SymmetricCsr::from_triplets(k.n, &triplets);
-            let penalised =
-                SymmetricCsr::linear_combination(1.0, k, RIGID_SET_PENALTY * largest, &penalty);
-            return (penalised, self.mass.clone());
-        }
         let stiffness = self.modal_stiffness.as_ref().unwrap_or(&self.stiffness);
         let dofs: Vec<usize> = (0..3 * self.elastic_nodes).collect();
         if dofs.len() == stiffness.n {
             return (stiffness.clone(), self.mass.clone());
         }
         (stiffness.submatrix(&dofs), self.mass.submatrix(&dofs))
+    }
+
+    /// On a reduced body with rigid sets, `T` (free DOFs × kept coordinates) with `x = T y`:
+    /// every free DOF outside the rigid sets kept, each set's points (3 or 4,
+    /// `body::reduction`) replaced by the set's six rigid motions at the reference
+    /// (`δx_i = u + θ × X̂_i`); `None` otherwise. A modal analysis in `y` (`Tᵀ K T`, `Tᵀ M T`)
+    /// holds the sets rigid exactly: a set's fourth point may move only mass points, which
+    /// would leave `K` a null space there. (The mesh body's analysis leaves the sets' constraints
+    /// out.)
+    pub fn rigid_set_motions(&self) -> Option<nalgebra::DMatrix<f64>> {
+        let sets: Vec<&RigidConstraint> = self.rigid.iter().filter(|s| s.lock.is_none()).collect();
+        if !self.rigid_sets_in_modes || sets.is_empty() {
+            return None;
+        }
+        let n = self.dof_count();
+        let mut in_set = vec![false; n];
+        for set in &sets {
+            for &r in &set.free_rows {
+                in_set[r..r + 3].iter_mut().for_each(|f| *f = true);
+            }
+        }
+        let kept = in_set.iter().filter(|&&f| !f).count();
+        let mut t = nalgebra::DMatrix::zeros(n, kept + 6 * sets.len());
+        for (column, row) in (0..n).filter(|&r| !in_set[r]).enumerate() {
+            t[(row, column)] = 1.0;
+        }
+        for (j, set) in sets.iter().enumerate() {
+            let first = kept + 6 * j;
+            for (&r, offset) in set.free_rows.iter().zip(&set.offsets) {
+                for d in 0..3 {
+                    t[(r + d, first + d)] = 1.0;
+                    let rotation = nalgebra::Vector3::ith(d, 1.0).cross(offset);
+                    for e in 0..3 {
+                        t[(r + e, first + 3 + d)] = rotation[e];
+                    }
+                }
+            }
+        }
+        Some(t)
     }
 
     /// The global DOFs of the free nodes, in the order of the reduced system.

@@ -25,6 +25,7 @@ Usage: python controlled_arm.py --fmu controlled_arm.fmu [--step 0.01] [--end 20
 
 import argparse
 import math
+import time
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -78,8 +79,9 @@ def largest_stable_step(inertia: float, kp: float, kd: float) -> float:
 class Arm:
     """The arm FMU instantiated and initialized (fmpy's FMU2Slave)."""
 
-    def __init__(self, unzipdir: str, model_description, name: str = "arm"):
+    def __init__(self, unzipdir: str, model_description, name: str = "arm", parameters=None):
         self.vr = {v.name: v.valueReference for v in model_description.modelVariables}
+        types = {v.name: v.type for v in model_description.modelVariables}
         self.fmu = FMU2Slave(
             guid=model_description.guid,
             unzipDirectory=unzipdir,
@@ -89,6 +91,11 @@ class Arm:
         self.fmu.instantiate()
         self.fmu.setupExperiment(startTime=0.0)
         self.fmu.enterInitializationMode()
+        for parameter, value in (parameters or {}).items():
+            if types[parameter] == "Integer":
+                self.fmu.setInteger([self.vr[parameter]], [int(value)])
+            else:
+                self.fmu.setReal([self.vr[parameter]], [value])
         self.fmu.exitInitializationMode()
         self.rotation = [self.vr[f"hub.rotation[{i}]"] for i in range(1, 10)]
         self.tip = [self.vr[f"tip.position[{i}]"] for i in (1, 2)]
@@ -111,14 +118,17 @@ class Arm:
         self.fmu.freeInstance()
 
 
-def run(unzipdir: str, model_description, h: float, t_end: float, omega_c: float = 2.0, zeta: float = 1.0):
+def run(unzipdir: str, model_description, h: float, t_end: float, omega_c: float = 2.0, zeta: float = 1.0,
+        parameters=None):
     """The controlled spin-up with communication step h until t_end (or until the FMU refuses a
-    step); returns a dict of arrays at the communication points: time, angle, reference, rate,
-    reference rate, torque, tip deflection; and 'completed' (whether t_end was reached)."""
+    step), the FMU's `parameters` (name: value) set in initialization mode; returns a dict of
+    arrays at the communication points: time, angle, reference, rate, reference rate, torque, tip
+    deflection; 'completed' (whether t_end was reached) and 'seconds' (wall time of the loop)."""
     from fmpy.fmi1 import FMICallException
 
     kp, kd = gains(omega_c, zeta)
-    arm = Arm(unzipdir, model_description, f"arm-{h}")
+    arm = Arm(unzipdir, model_description, f"arm-{h}", parameters)
+    started = time.perf_counter()
     rows = {n: [] for n in ("time", "angle", "reference", "rate", "reference_rate", "torque", "deflection")}
     completed = True
     try:
@@ -139,9 +149,11 @@ def run(unzipdir: str, model_description, h: float, t_end: float, omega_c: float
                 completed = False
                 break
     finally:
+        seconds = time.perf_counter() - started
         arm.free()
     history = {n: np.array(v) for n, v in rows.items()}
     history["completed"] = completed
+    history["seconds"] = seconds
     return history
 
 

@@ -164,7 +164,14 @@ pub(super) fn lowest_modes(
     damping: (f64, f64),
 ) -> Result<LowestModes> {
     let supported = !free.clamped.is_empty();
-    let (k, m) = free.elastic_matrices();
+    let (k_full, m_full) = free.elastic_matrices();
+    // A reduced body's rigid sets held exactly: the analysis in the coordinates `y` of
+    // `x = T y` (FreeNodes::rigid_set_motions), its modes mapped back.
+    let motions = free.rigid_set_motions();
+    let (k, m) = match &motions {
+        Some(t) => (projected(&k_full, t), projected(&m_full, t)),
+        None => (k_full.clone(), m_full.clone()),
+    };
     let (k, m) = (&k, &m);
     let diagonal = |a: &SymmetricCsr, i: usize| {
         (a.row_ptr[i]..a.row_ptr[i + 1])
@@ -192,6 +199,13 @@ pub(super) fn lowest_modes(
         .eigenvalues
         .iter_mut()
         .for_each(|w2| *w2 = (*w2 - shift).max(0.0));
+    if let Some(t) = &motions {
+        for mode in &mut pairs.modes {
+            *mode = (t * nalgebra::DVector::from_column_slice(mode))
+                .as_slice()
+                .to_vec();
+        }
+    }
     let omega = pairs.eigenvalues[index.min(count - 1)].sqrt();
     if !(omega.is_finite() && omega > 0.0) {
         return Err(Error::new(format!(
@@ -200,10 +214,28 @@ pub(super) fn lowest_modes(
     }
     Ok(LowestModes::new(
         &free.nodes[..free.elastic_nodes],
-        m,
+        &m_full,
         &pairs,
         index,
         total_mass,
         damping,
     ))
+}
+
+/// `Tᵀ A T` of a symmetric `A` (dense: a reduced body's size).
+fn projected(a: &SymmetricCsr, t: &nalgebra::DMatrix<f64>) -> SymmetricCsr {
+    let mut dense = nalgebra::DMatrix::zeros(a.n, a.n);
+    for row in 0..a.n {
+        for k in a.row_ptr[row]..a.row_ptr[row + 1] {
+            dense[(row, a.col_idx[k])] = a.values[k];
+        }
+    }
+    let p = t.transpose() * dense * t;
+    let n = p.nrows();
+    let triplets: Vec<(usize, usize, f64)> = (0..n)
+        .flat_map(|i| (0..n).map(move |j| (i, j)))
+        .map(|(i, j)| (i, j, 0.5 * (p[(i, j)] + p[(j, i)])))
+        .filter(|&(_, _, v)| v != 0.0)
+        .collect();
+    SymmetricCsr::from_triplets(n, &triplets)
 }
