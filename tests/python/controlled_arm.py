@@ -94,6 +94,8 @@ class Arm:
         for parameter, value in (parameters or {}).items():
             if types[parameter] == "Integer":
                 self.fmu.setInteger([self.vr[parameter]], [int(value)])
+            elif types[parameter] == "Boolean":
+                self.fmu.setBoolean([self.vr[parameter]], [bool(value)])
             else:
                 self.fmu.setReal([self.vr[parameter]], [value])
         self.fmu.exitInitializationMode()

@@ -54,23 +54,3 @@ def test_stable_below_the_hub_bound_and_unstable_above(arm_unzipdir, arm_model_d
     print(f"H = {1.5 * H_LIMIT:.3f} s: completed {unstable['completed']}, largest rate error {rate_error:.3e} rad/s")
     assert not unstable["completed"] or rate_error > 1.0
 
-
-def test_the_reduced_arm_tracks_the_spin_up(arm_unzipdir, arm_model_description):
-    # The same arm as a reduced body (model.modes = 8): its rigid hub is a boundary set of the
-    # basis and the hinge holds it (docs/formulation.md, "Rigid attachments", on the reduced
-    # body). The loop tracks as on the mesh, and the beam lags and straightens as there; the
-    # reduced body keeps one co-moving frame (model.auto's slabs are the mesh body's), whose
-    # error on B3 is 1.6 % of the peak.
-    mesh = run(arm_unzipdir, arm_model_description, 0.01, 20.0)
-    reduced = run(arm_unzipdir, arm_model_description, 0.01, 20.0, parameters={"model.modes": 8})
-    assert reduced["completed"]
-    error = np.abs(reduced["angle"] - reduced["reference"])
-    deflection, t = reduced["deflection"], reduced["time"]
-    difference = np.abs(reduced["deflection"] - mesh["deflection"]).max() / np.abs(mesh["deflection"]).max()
-    print(f"reduced: largest tracking error {error.max():.3e} rad; tip deflection peak {deflection.min():.4f} m "
-          f"at {t[np.argmin(deflection)]:.2f} s; {difference:.3e} of the mesh body's peak from it; "
-          f"{reduced['seconds']:.2f} s against the mesh body's {mesh['seconds']:.2f} s")
-    assert error.max() < 5e-3
-    assert -0.60 < deflection.min() < -0.54
-    assert np.abs(deflection[t > 18.0]).max() < 0.02
-    assert difference < 0.03
