@@ -250,3 +250,22 @@ fn a_rebuilt_reduced_body_has_the_basis_of_a_fresh_one() {
         get(&mut s, "tip.position[2]")
     );
 }
+
+/// A rigid attachment sharing nodes with a fixed support on a reduced body is refused, naming
+/// both (two boundary sets of the basis on the same nodes).
+#[test]
+fn a_rigid_set_on_a_supports_nodes_is_refused_by_name() {
+    let mut body = flexbody::model::BodyFile::default_body();
+    let mut hub = body.interfaces[0].clone();
+    (hub.name, hub.kind, hub.rigid) = ("hub".into(), flexbody::model::InterfaceKind::Force, true);
+    body.interfaces.push(hub);
+    let mut s = flexbody::slave::Slave::from_body(body).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.modes", 4.0);
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(
+        e.message.contains("'hub'") && e.message.contains("'root'"),
+        "{e}"
+    );
+}

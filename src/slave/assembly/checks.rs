@@ -120,6 +120,37 @@ impl Slave {
                         spec.name, i.kind
                     )
                 })
+                .or_else(|| {
+                    // Two boundary sets of the basis may not share nodes (their affine motions
+                    // would not be independent).
+                    let held = self.interfaces.iter().zip(specs).filter(|(i, _)| {
+                        matches!(i.kind, InterfaceKind::Fixed | InterfaceKind::Motion)
+                    });
+                    held.flat_map(|(h, h_spec)| {
+                        self.interfaces
+                            .iter()
+                            .zip(specs)
+                            .filter(|(i, spec)| {
+                                spec.rigid && i.kind != InterfaceKind::Fixed
+                                    && i.kind != InterfaceKind::Motion
+                            })
+                            .filter(move |(i, _)| {
+                                i.set
+                                    .frame_weights
+                                    .nodes
+                                    .iter()
+                                    .any(|n| h.set.frame_weights.nodes.contains(n))
+                            })
+                            .map(move |(_, spec)| (h_spec, spec))
+                    })
+                    .next()
+                    .map(|(h_spec, spec)| {
+                        format!(
+                            "interface '{}' is a rigid attachment on nodes that '{}' holds: on a reduced body a rigid set and a {:?} interface may not share nodes",
+                            spec.name, h_spec.name, h_spec.kind
+                        )
+                    })
+                })
         };
         match reason {
             Some(r) => Err(Error::invalid_value(
