@@ -648,7 +648,6 @@ fn fmu_state_of_a_reduced_body_round_trips() {
 fn unsupported_combinations_are_errors_naming_the_parameter() {
     for (setting, value, reason) in [
         ("model.formulation", 2.0, "full"),
-        ("model.frames", 3.0, "frames"),
         ("model.stiffening", 2.0, "stiffening"),
         ("solver.integrator", 2.0, "centralDifference"),
     ] {

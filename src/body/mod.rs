@@ -137,6 +137,9 @@ pub struct ForceScratch {
     mass_times: Vec<f64>,
     stiffening_force: Vec<f64>,
     patch: Option<patches::PatchScratch>,
+    /// A reduced body with patches: the expanded nodes' positions and their patch forces
+    /// (flat `3N` of the mesh each).
+    expanded: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl ForceScratch {
@@ -315,6 +318,11 @@ impl Body {
             mass_times: vec![0.0; n3],
             stiffening_force: vec![0.0; n3],
             patch: self.patches.as_ref().map(Patches::scratch),
+            expanded: self
+                .reduction
+                .as_ref()
+                .filter(|_| self.patches.is_some())
+                .map(|r| (vec![0.0; 3 * r.node_count], vec![0.0; 3 * r.node_count])),
         }
     }
 
@@ -372,8 +380,24 @@ impl Body {
             f64::NAN
         } else if let Some(patches) = &self.patches {
             g.fill(0.0); // global frame
-            let scratch = scratch.patch.as_mut().expect("patch scratch");
-            patches.internal_force(x, self.options.nonlinear_forces, scratch, g)
+            let patch_scratch = scratch.patch.as_mut().expect("patch scratch");
+            match (&self.reduction, scratch.expanded.as_mut()) {
+                // A reduced body's patches act on its expanded nodes (docs/formulation.md,
+                // "The reduced body": several frames): `x = (S ⊗ I3) q`, `f_q = (S ⊗ I3)ᵀ f`.
+                (Some(reduction), Some((nodes, forces))) => {
+                    reduction.expand_into(x, nodes);
+                    forces.fill(0.0);
+                    let energy = patches.internal_force(
+                        nodes,
+                        self.options.nonlinear_forces,
+                        patch_scratch,
+                        forces,
+                    );
+                    reduction.project_into(forces, g);
+                    energy
+                }
+                _ => patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g),
+            }
         } else {
             self.stiffness_product.mul_vec(ubar, g);
             0.5 * dot(ubar, g)

@@ -289,6 +289,34 @@ impl Reduction {
         }
     }
 
+    /// [`Self::expand`] into `x` (flat `3N`); no allocation.
+    pub fn expand_into(&self, q: &[f64], x: &mut [f64]) {
+        for i in 0..self.node_count {
+            let mut xi = Vector3::zeros();
+            for (k, &s) in self.row(i).iter().enumerate() {
+                xi += s * node(q, k);
+            }
+            x[3 * i..3 * i + 3].copy_from_slice(xi.as_slice());
+        }
+    }
+
+    /// The reduced vector `f_k = Σ_i S_ik f_i` (flat `3s`) of nodal forces `f` (flat `3N`): the
+    /// generalized forces of the coordinates, `(S ⊗ I3)ᵀ f`. No allocation.
+    pub fn project_into(&self, f: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
+        for i in 0..self.node_count {
+            let fi = node(f, i);
+            if fi == Vector3::zeros() {
+                continue;
+            }
+            for (k, &s) in self.row(i).iter().enumerate() {
+                for d in 0..3 {
+                    out[3 * k + d] += s * fi[d];
+                }
+            }
+        }
+    }
+
     /// The expanded nodal vector `x_i = Σ_k S_ik q_k` (flat `3N`) of a reduced vector `q`
     /// (flat `3s`): positions, velocities or accelerations.
     pub fn expand(&self, q: &[f64]) -> Vec<f64> {

@@ -399,7 +399,23 @@ impl Slave {
                 }
             }
         }
-        Ok((Body::reduced(reduction, options), clamped))
+        let fields = reduction.field_count;
+        let mut body = Body::reduced(reduction, options);
+        if p.frames > 1 {
+            // Several co-moving frames act on the expanded nodes (docs/formulation.md, "The
+            // reduced body").
+            let mesh_lumped = &lumped[..self.mesh.node_count()];
+            body = body.with_patches(
+                Patches::along_principal_axis(
+                    &self.mesh,
+                    &p.material,
+                    mesh_lumped,
+                    p.frames as usize,
+                )?
+                .covering(fields),
+            );
+        }
+        Ok((body, clamped))
     }
 
     /// The solver's side of a model build: free nodes, constraints, stiffening, `model.auto`'s

@@ -577,10 +577,11 @@ impl IterationMatrix {
         frame: &'a Matrix3<f64>,
         forces: &'a ResidualWorkspace,
     ) -> impl Fn(usize) -> Matrix3<f64> + 'a {
-        let patches = body
-            .patches
-            .as_ref()
-            .filter(|_| self.constraint.is_none() && self.newton.is_none());
+        // (A reduced body's coordinates belong to no patch: its patches act on the expanded
+        // nodes.)
+        let patches = body.patches.as_ref().filter(|_| {
+            self.constraint.is_none() && self.newton.is_none() && body.reduction.is_none()
+        });
         let scratch = &forces.force_scratch;
         move |i: usize| match patches {
             Some(p) => scratch.patch_rotation(p.node_patch[i]),

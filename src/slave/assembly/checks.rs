@@ -72,11 +72,6 @@ impl Slave {
             Some(
                 "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
             )
-        } else if p.frames > 1 {
-            Some(format!(
-                "model.frames = {}: a reduced body has one co-moving frame",
-                p.frames
-            ))
         } else if p.stiffening != Stiffening::None {
             Some(format!(
                 "model.stiffening = {}: geometric stiffening is not projected on the modes",
