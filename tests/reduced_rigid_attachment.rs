@@ -272,3 +272,31 @@ fn a_rigid_set_on_a_supports_nodes_is_refused_by_name() {
         "{e}"
     );
 }
+
+/// A reduced body whose rebuild failed leaves no model behind: after `model.modes` = 100 000
+/// (refused) and a reset, `model.modes = 4` gives the fresh instance's tip (the failed build had
+/// put the sets back on the mesh while the old model stayed cached, and the next start indexed
+/// mesh nodes in the reduced coordinates).
+#[test]
+fn a_failed_reduced_build_leaves_nothing_stale() {
+    let tip_after_a_step = |s: &mut flexbody::slave::Slave| {
+        s.do_step(0.0, 1e-3).unwrap();
+        get(s, "tip.position[2]")
+    };
+    let mut fresh = initialized_default(&[("model.modes", 4.0), ("tip.force[2]", -10.0)]);
+    let expected = tip_after_a_step(&mut fresh);
+    let mut s = initialized_default(&[("model.modes", 4.0), ("tip.force[2]", -10.0)]);
+    tip_after_a_step(&mut s);
+    s.reset();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.modes", 100_000.0);
+    assert!(s.exit_initialization_mode().is_err());
+    s.reset();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.modes", 4.0);
+    set(&mut s, "tip.force[2]", -10.0);
+    s.exit_initialization_mode().unwrap();
+    assert_eq!(tip_after_a_step(&mut s), expected);
+}

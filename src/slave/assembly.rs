@@ -125,6 +125,9 @@ impl Slave {
         if self.model.as_ref().is_some_and(|m| m.key == key) {
             return Ok(());
         }
+        // The build changes the interfaces' sets before it can fail: no old model may outlive
+        // a failed one (a reduced body's sets would then be the mesh's).
+        self.model = None;
         let p = &self.parameters;
         p.material.validate()?;
         self.check_regions()?;
@@ -399,21 +402,17 @@ impl Slave {
                 }
             }
         }
-        let fields = reduction.field_count;
         let mut body = Body::reduced(reduction, options);
         if p.frames > 1 {
             // Several co-moving frames act on the expanded nodes (docs/formulation.md, "The
             // reduced body").
             let mesh_lumped = &lumped[..self.mesh.node_count()];
-            body = body.with_patches(
-                Patches::along_principal_axis(
-                    &self.mesh,
-                    &p.material,
-                    mesh_lumped,
-                    p.frames as usize,
-                )?
-                .covering(fields),
-            );
+            body = body.with_patches(Patches::along_principal_axis(
+                &self.mesh,
+                &p.material,
+                mesh_lumped,
+                p.frames as usize,
+            )?);
         }
         Ok((body, clamped))
     }

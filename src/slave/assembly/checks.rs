@@ -63,9 +63,9 @@ impl Slave {
         }
     }
 
-    /// `model.modes > 0` supports one generalized-α, single-frame, reduced-strain body without
-    /// stiffening, with pins and hinges on rigid sets only; anything else is an error naming the
-    /// parameter.
+    /// `model.modes > 0` supports a reduced-strain body (one frame or `model.frames` slabs),
+    /// generalized-α or Radau IIA, without stiffening, with pins and hinges on rigid sets only;
+    /// anything else is an error naming the parameter.
     pub(in crate::slave) fn check_reducible(&self) -> Result<()> {
         let p = &self.parameters;
         let reason = if p.formulation == Formulation::Full {

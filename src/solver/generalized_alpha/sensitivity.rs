@@ -171,7 +171,8 @@ pub fn linear_step(
 }
 
 /// The frame of node `i`'s rows in the iteration matrix (`IterationMatrix::node_rotation`; the
-/// lumped bodies' mass points, which have no stiffness, take the body's frame).
+/// lumped bodies' mass points, which have no stiffness, take the body's frame, and so do a
+/// reduced body's coordinates, which belong to no patch).
 fn node_rotation(
     constrained: bool,
     body: &Body,
@@ -179,7 +180,11 @@ fn node_rotation(
     forces: &ResidualWorkspace,
     i: usize,
 ) -> Matrix3<f64> {
-    match body.patches.as_ref().filter(|_| !constrained) {
+    let patches = body
+        .patches
+        .as_ref()
+        .filter(|_| !constrained && body.reduction.is_none());
+    match patches {
         Some(p) if i < p.node_patch.len() => forces.force_scratch.patch_rotation(p.node_patch[i]),
         _ => *frame,
     }
