@@ -375,19 +375,9 @@ fn the_reduced_body_has_its_step_jacobian_too() {
         .copied()
         .filter(|o| !o.starts_with("root.torque"))
         .collect();
+    let deltas = [1.0, 1.0, 1.0, 0.1, 0.1];
     let (mut s, saved, t) = b1_after(-10.0, &[("model.modes", 8.0)]);
-    let numeric = stepped_differences(
-        &mut s,
-        &|_| {},
-        &saved,
-        t,
-        1e-3,
-        &outputs,
-        &TIP_INPUTS,
-        &[1.0, 1.0, 1.0, 0.1, 0.1],
-    );
-    let analytic = step_jacobian(&mut s, &|_| {}, &saved, t, 1e-3, &outputs, &TIP_INPUTS);
-    let worst = worst_relative_difference(&outputs, TIP_INPUTS.len(), &analytic, &numeric);
+    let worst = compared_from(&mut s, &saved, t, 1e-3, &outputs, &TIP_INPUTS, &deltas);
     assert!(worst < 2e-5, "reduced B1: {worst:e}");
     // With six slabs under 500 N (the tip 7 mm down; damped, β = 1 ms, 60 steps of 1 ms): the
     // slabs act on the expanded nodes, and the linearised step's matrix stays in the body's frame
@@ -401,22 +391,7 @@ fn the_reduced_body_has_its_step_jacobian_too() {
         ("model.frames", 6.0),
         ("damping.beta", 1e-3),
     ]);
-    for k in 0..60 {
-        s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
-    }
-    let (saved, t) = (s.get_state(), 0.06);
-    let numeric = stepped_differences(
-        &mut s,
-        &|_| {},
-        &saved,
-        t,
-        1e-3,
-        &outputs,
-        &TIP_INPUTS,
-        &[1.0, 1.0, 1.0, 0.1, 0.1],
-    );
-    let analytic = step_jacobian(&mut s, &|_| {}, &saved, t, 1e-3, &outputs, &TIP_INPUTS);
-    let worst = worst_relative_difference(&outputs, TIP_INPUTS.len(), &analytic, &numeric);
+    let worst = compared_after(&mut s, 60, 1e-3, 1e-3, &outputs, &TIP_INPUTS, &deltas);
     assert!(worst < 2e-5, "reduced B1 with slabs: {worst:e}");
     let omega = 2.0;
     let mut s = initialized(
