@@ -78,7 +78,7 @@ impl FreeNodes {
     /// `K` and `M ⊗ I3` on the free mesh nodes' DOFs (without the lumped bodies' mass points,
     /// whose zero stiffness would add zero frequencies, and with the elements inside rigid sets,
     /// whose constraints a modal analysis does not see): what a modal analysis of the elastic
-    /// body takes (on a reduced body with rigid sets, in the coordinates of
+    /// body takes (a reduced body's analysis holds its rigid sets on top of these:
     /// [`Self::rigid_set_motions`]).
     pub fn elastic_matrices(&self) -> (SymmetricCsr, SymmetricCsr) {
         let stiffness = self.modal_stiffness.as_ref().unwrap_or(&self.stiffness);
