@@ -36,7 +36,10 @@ impl Slave {
             // Initialization mode: outputs of the rigidly placed body with the current inputs.
             self.ensure_initial_state()?;
         }
-        let model = self.model.as_mut().unwrap();
+        // (No model after a build that failed: ensure_model clears it first.)
+        let model = self.model.as_mut().ok_or_else(|| {
+            Error::new("the body's model could not be built (see the error that said why)")
+        })?;
         let dynamics = self.dynamics.as_ref().unwrap();
         let state = &dynamics.state;
         let body = &model.body;
