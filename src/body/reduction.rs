@@ -321,13 +321,7 @@ impl Reduction {
     /// (flat `3s`): positions, velocities or accelerations.
     pub fn expand(&self, q: &[f64]) -> Vec<f64> {
         let mut x = vec![0.0; 3 * self.node_count];
-        for i in 0..self.node_count {
-            let mut xi = Vector3::zeros();
-            for (k, &s) in self.row(i).iter().enumerate() {
-                xi += s * node(q, k);
-            }
-            x[3 * i..3 * i + 3].copy_from_slice(xi.as_slice());
-        }
+        self.expand_into(q, &mut x);
         x
     }
 }

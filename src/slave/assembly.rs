@@ -219,15 +219,8 @@ impl Slave {
     /// pin or hinge with `"rigid": true`).
     fn elements_inside_rigid_sets(&self) -> Vec<bool> {
         let mut inside = vec![false; self.mesh.element_count()];
-        for (interface, spec) in self.interfaces.iter().zip(&self.body_file.interfaces) {
-            let rigid = spec.rigid
-                && matches!(
-                    interface.kind,
-                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
-                );
-            if !rigid {
-                continue;
-            }
+        let rigid = self.rigid_attachments();
+        for (interface, _) in self.interfaces.iter().zip(&rigid).filter(|(_, &r)| r) {
             let mut in_set = vec![false; self.mesh.node_count()];
             for &n in &interface.set.frame_weights.nodes {
                 if n < in_set.len() {

@@ -87,17 +87,12 @@ impl Slave {
             // A pin or hinge holds a point of a rigid set (its own, or another's on the same
             // nodes): a boundary set of the basis, whose points the constraint holds exactly.
             let specs = &self.body_file.interfaces;
+            let rigid = self.rigid_attachments();
             let rigid_sets: Vec<&[usize]> = self
                 .interfaces
                 .iter()
-                .zip(specs)
-                .filter(|(i, spec)| {
-                    spec.rigid
-                        && matches!(
-                            i.kind,
-                            InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
-                        )
-                })
+                .zip(&rigid)
+                .filter(|(_, &r)| r)
                 .map(|(i, _)| &i.set.frame_weights.nodes[..])
                 .collect();
             self.interfaces
@@ -125,18 +120,16 @@ impl Slave {
                         self.interfaces
                             .iter()
                             .zip(specs)
-                            .filter(|(i, spec)| {
-                                spec.rigid && i.kind != InterfaceKind::Fixed
-                                    && i.kind != InterfaceKind::Motion
-                            })
-                            .filter(move |(i, _)| {
-                                i.set
+                            .zip(&rigid)
+                            .filter(move |((i, _), &r)| {
+                                r && i
+                                    .set
                                     .frame_weights
                                     .nodes
                                     .iter()
                                     .any(|n| h.set.frame_weights.nodes.contains(n))
                             })
-                            .map(move |(_, spec)| (h_spec, spec))
+                            .map(move |((_, spec), _)| (h_spec, spec))
                     })
                     .next()
                     .map(|(h_spec, spec)| {
@@ -163,15 +156,14 @@ impl Slave {
     /// the conflict between their linearisations). Error naming the interfaces.
     pub(super) fn check_held_points_on_rigid_sets(&self) -> Result<()> {
         let specs = &self.body_file.interfaces;
-        for (rigid, rigid_spec) in self.interfaces.iter().zip(specs) {
-            let is_rigid_set = rigid_spec.rigid
-                && matches!(
-                    rigid.kind,
-                    InterfaceKind::Force | InterfaceKind::Pin | InterfaceKind::Hinge
-                );
-            if !is_rigid_set {
-                continue;
-            }
+        let is_rigid_set = self.rigid_attachments();
+        for ((rigid, rigid_spec), _) in self
+            .interfaces
+            .iter()
+            .zip(specs)
+            .zip(&is_rigid_set)
+            .filter(|(_, &r)| r)
+        {
             let nodes = &rigid.set.frame_weights.nodes;
             let mut held = Vec::new();
             for (interface, spec) in self.interfaces.iter().zip(specs) {
