@@ -6,7 +6,11 @@ up on a shared machine: interleaved paired runs (issue 17).
 Each side is a separate process that builds its model (setup, timed on its own) and then runs
 B1 for a short and a long time (2 s and 10 s simulated, fixed step h), each from a fresh model:
 ours is `examples/reduced_run.rs` (PATH: its release binary; the reduced body with 8 modes: 46
-fields with the supports' constraint and the tip's attachment fields, 138 coordinates), the peers are bench/peers.py's
+fields with the supports' constraint and the tip's attachment fields, 138 coordinates), once as
+the reduced-strain body and once as the linear body (`--linear 1`, `model.linear`: the frame held
+at the clamp, one linear solve per step; Exudyn's floating frame, fixed to the ground by the
+clamp's joint, is linear in its modal coordinates too, so this is the like-for-like pair; the
+table's tip y at the short run's end shows both at the same answer), the peers are bench/peers.py's
 reduced models (CB-8: 8 fixed-root eigenmodes; CB-8 + tip: the tip face as a second boundary, 14
 coordinates) in Exudyn's regular module and its fast module (`exudynCPPfast`: no range checks,
 vector extensions), selected per process. The cost of a step is the difference of the two runs'
@@ -100,7 +104,8 @@ def main():
         return worker(args)
 
     timing = ["--h", str(args.h), "--short", str(args.short), "--long", str(args.long)]
-    sides = [("ours", [args.ours, *timing])]
+    ours = [("ours", [args.ours, *timing]), ("ours, linear", [args.ours, *timing, "--linear", "1"])]
+    sides = list(ours)
     for name, model, fast in PEERS:
         command = [sys.executable, os.path.abspath(__file__), "--worker", "--matrices", args.matrices,
                    "--model", model, *timing] + (["--fast"] if fast else [])
@@ -123,12 +128,13 @@ def main():
     header = " | ".join(f"series {k + 1}: median (range)" for k in range(args.series))
     print(f"| ours / peer, per step | {header} |")
     print("|---|" + "---|" * args.series)
-    for name, _ in sides[1:]:
-        cells = []
-        for rounds in results:
-            ratios = [per_step(r["ours"]) / per_step(r[name]) for r in rounds]
-            cells.append(f"{statistics.median(ratios):.2f} ({min(ratios):.2f}–{max(ratios):.2f})")
-        print(f"| {name} | " + " | ".join(cells) + " |")
+    for mine, _ in ours:
+        for name, _ in sides[len(ours):]:
+            cells = []
+            for rounds in results:
+                ratios = [per_step(r[mine]) / per_step(r[name]) for r in rounds]
+                cells.append(f"{statistics.median(ratios):.2f} ({min(ratios):.2f}–{max(ratios):.2f})")
+            print(f"| {mine} / {name} | " + " | ".join(cells) + " |")
 
 
 if __name__ == "__main__":

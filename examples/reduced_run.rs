@@ -5,7 +5,10 @@
 //! difference (which cancels what a run costs once: the first factorization, the first
 //! residual).
 //!
-//! `cargo run --release --example reduced_run -- [--h 1e-3] [--modes 8] [--short 2] [--long 10]`
+//! `cargo run --release --example reduced_run -- [--h 1e-3] [--modes 8] [--short 2] [--long 10]
+//! [--linear 1]`
+//!
+//! `--linear 1`: the linear body (`model.linear`, docs/formulation.md, "The linear body").
 //!
 //! B1 as `bench/peers.py`: the default cantilever, 10 N in −y on `tip` from t = 0, no damping,
 //! ρ∞ = 0.9, communication step 2 ms (the peers' sensor period). `setup_s`: from the body file to
@@ -25,12 +28,14 @@ struct Timing {
     tip_y: f64,
 }
 
-fn run(h: f64, modes: i32, end: f64) -> Timing {
+fn run(h: f64, modes: i32, linear: bool, end: f64) -> Timing {
     let started = Instant::now();
     let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();
     s.enter_initialization_mode().unwrap();
     s.set_by_name("model.modes", f64::from(modes)).unwrap();
+    s.set_by_name("model.linear", f64::from(u8::from(linear)))
+        .unwrap();
     s.set_by_name("model.accuracy", 0.0).unwrap();
     s.set_by_name("solver.stepSize", h).unwrap();
     s.set_by_name("tip.force[2]", -10.0).unwrap();
@@ -53,6 +58,7 @@ fn run(h: f64, modes: i32, end: f64) -> Timing {
 fn main() {
     let mut h = 1e-3;
     let mut modes = 8;
+    let mut linear = false;
     let (mut short, mut long) = (2.0, 10.0);
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -60,13 +66,14 @@ fn main() {
         match arg.as_str() {
             "--h" => h = value.parse().unwrap(),
             "--modes" => modes = value.parse().unwrap(),
+            "--linear" => linear = value == "1" || value == "true",
             "--short" => short = value.parse().unwrap(),
             "--long" => long = value.parse().unwrap(),
             other => panic!("unknown option {other}"),
         }
     }
-    let a = run(h, modes, short);
-    let b = run(h, modes, long);
+    let a = run(h, modes, linear, short);
+    let b = run(h, modes, linear, long);
     println!(
         "{{\"setup_s\": {:e}, \"setup_long_s\": {:e}, \"short_s\": {:e}, \"short_steps\": {}, \"long_s\": {:e}, \"long_steps\": {}, \"tip_y_short\": {:e}}}",
         a.setup, b.setup, a.stepping, a.steps, b.stepping, b.steps, a.tip_y

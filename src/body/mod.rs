@@ -94,6 +94,20 @@ pub struct Body {
     /// lowest period, `model.auto`'s modes), which do not see the sets' constraints;
     /// `stiffness_matrix` leaves those elements out (docs/formulation.md, "Rigid attachments").
     pub modal_stiffness: Option<SymmetricCsr>,
+    /// The geometrically linear body (docs/formulation.md, "The linear body"): when present the
+    /// co-moving frame is held at this placement instead of fitted to the positions, so the
+    /// internal force `R₀ K (R₀ᵀ(x − c₀) − X̄)` is linear in `x` and a step is one linear solve.
+    pub linear: Option<LinearPlacement>,
+}
+
+/// The placement a linear body's frame is held at: the frame `(c₀, R₀)` of its supports, and
+/// the positions of the undeformed body there, `x₀_i = e_i c₀ + R₀ X̄_i` (on which the loads of
+/// a linear body act: they do not follow the deformation either).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearPlacement {
+    pub frame: Frame,
+    /// `x₀` (flat `3N`, m).
+    pub positions: Vec<f64>,
 }
 
 /// How a constant `3N × 3N` matrix is stored for the products of the hot path.
@@ -193,6 +207,7 @@ impl Body {
             nonlinear_forces_switchable: false,
             lumped_points: 0,
             modal_stiffness: None,
+            linear: None,
         }
     }
 
@@ -223,6 +238,7 @@ impl Body {
             nonlinear_forces_switchable: false,
             lumped_points: 0,
             modal_stiffness: None,
+            linear: None,
         }
     }
 
@@ -293,13 +309,41 @@ impl Body {
     /// deformation"). No allocation.
     pub fn local_deformation(&self, x: &[f64], ubar: &mut [f64]) -> Frame {
         let fw = &self.frame_weights;
-        let frame = fw.best_fit(x);
+        let frame = match &self.linear {
+            Some(placement) => placement.frame,
+            None => fw.best_fit(x),
+        };
         let rt = frame.rotation.transpose();
         for i in 0..self.node_count() {
             let u = rt * (node(x, i) - fw.unit(i) * frame.origin) - fw.reference_offsets[i];
             set_node(ubar, i, &u);
         }
         frame
+    }
+
+    /// The placement of the undeformed body whose best-fit frame is that of positions `x` (a
+    /// body placed rigidly: its placement), for [`Body::linear`].
+    pub fn linear_placement(&self, x: &[f64]) -> LinearPlacement {
+        let fw = &self.frame_weights;
+        let frame = fw.best_fit(x);
+        let mut positions = vec![0.0; x.len()];
+        for i in 0..self.node_count() {
+            let p = fw.unit(i) * frame.origin + frame.rotation * fw.reference_offsets[i];
+            set_node(&mut positions, i, &p);
+        }
+        LinearPlacement { frame, positions }
+    }
+
+    /// Whether the internal force is linear in the positions and velocities with the iteration
+    /// matrix's `K`, `M` and damping as its exact Jacobian (a linear body with one frame,
+    /// reduced strain, no `f_nl` and no geometric stiffness `K_G`, which the matrix leaves
+    /// out): then the first correction of a step solves it.
+    pub fn steps_linearly(&self, geometric_stiffness: bool) -> bool {
+        self.linear.is_some()
+            && !self.options.nonlinear_forces
+            && self.patches.is_none()
+            && self.full.is_none()
+            && !geometric_stiffness
     }
 
     /// Number of nodes `N`.
@@ -406,14 +450,28 @@ impl Body {
             kg.mul_vec(ubar, &mut scratch.stiffening_force);
         }
 
-        let h = fw.rotation_sensitivity(&frame, x);
-        let h_inv = h.try_inverse().unwrap_or_else(Matrix3::zeros);
+        // A linear body's frame does not move: `ω̄ = 0`, `ċ = 0` and no `f_nl`.
+        let linear = self.linear.is_some();
+        let h_inv = if linear {
+            Matrix3::zeros()
+        } else {
+            let h = fw.rotation_sensitivity(&frame, x);
+            h.try_inverse().unwrap_or_else(Matrix3::zeros)
+        };
         let damped = self.options.damping_alpha != 0.0 || self.options.damping_beta != 0.0;
-        let angular_velocity_body = fw.angular_velocity(&frame, &h_inv, v);
+        let angular_velocity_body = if linear {
+            Vector3::zeros()
+        } else {
+            fw.angular_velocity(&frame, &h_inv, v)
+        };
 
         // g ← g + β K dū/dt + α Ms dū/dt, all in the co-moving frame.
         if damped {
-            let cdot = fw.centroid(v);
+            let cdot = if linear {
+                Vector3::zeros()
+            } else {
+                fw.centroid(v)
+            };
             let rate = &mut scratch.deformation_rate;
             for i in 0..n {
                 let y = fw.reference_offsets[i] + node(ubar, i);
@@ -434,12 +492,19 @@ impl Body {
                 // is not damped, and ẋᵀ f = α (ẋ − v_r)ᵀ M (ẋ − v_r) ≥ 0 always dissipates.
                 // (Weighting the relative velocity by the frame's HRZ weights instead leaves a
                 // net force that can feed a slow oscillation of a driven body.)
-                let (centre, velocity, omega) = self.rigid_velocity(x, v, &mut scratch.mass_times);
+                // (A linear body is held: it has no rigid motion to leave out, and its damping
+                // stays linear in `ẋ`.)
                 let relative = &mut scratch.deformation_rate;
-                for i in 0..n {
-                    let e = fw.unit(i);
-                    let vr = e * velocity + omega.cross(&(node(x, i) - e * centre));
-                    set_node(relative, i, &(node(v, i) - vr));
+                if linear {
+                    relative.copy_from_slice(v);
+                } else {
+                    let (centre, velocity, omega) =
+                        self.rigid_velocity(x, v, &mut scratch.mass_times);
+                    for i in 0..n {
+                        let e = fw.unit(i);
+                        let vr = e * velocity + omega.cross(&(node(x, i) - e * centre));
+                        set_node(relative, i, &(node(v, i) - vr));
+                    }
                 }
                 let mt = &mut scratch.mass_times;
                 self.mass_times(relative, mt);
@@ -454,7 +519,8 @@ impl Body {
 
         // f_nl: z = H⁻ᵀ m̄, m̄ = Σ ū_i × g_i (elastic g only: f_nl is part of ∂V/∂x).
         let single = self.single_frame();
-        let z = if self.options.nonlinear_forces && single {
+        let nonlinear_forces = self.options.nonlinear_forces && single && !linear;
+        let z = if nonlinear_forces {
             let mut mbar = Vector3::zeros();
             for i in 0..n {
                 mbar += node(ubar, i).cross(&node(g, i));
@@ -476,7 +542,7 @@ impl Body {
             if geometric_stiffness.is_some() {
                 fi += node(&scratch.stiffening_force, i);
             }
-            if self.options.nonlinear_forces && single {
+            if nonlinear_forces {
                 fi -= fw.arms[i].cross(&z);
             }
             let mut global = r * fi;

@@ -277,6 +277,10 @@ pub struct ModelSpec {
     /// step `solver.stepSize`.
     #[serde(default = "ModelSpec::default_accuracy")]
     pub accuracy: f64,
+    /// `model.linear`: the geometrically linear body forced (docs/formulation.md, "The linear
+    /// body"); false (the default): `model.auto` decides.
+    #[serde(default)]
+    pub linear: bool,
 }
 
 impl Default for ModelSpec {
@@ -287,6 +291,7 @@ impl Default for ModelSpec {
             modes: ModesSpec::default(),
             auto: ModelSpec::default_auto(),
             accuracy: ModelSpec::default_accuracy(),
+            linear: false,
         }
     }
 }

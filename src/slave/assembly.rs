@@ -8,7 +8,8 @@ use crate::body::lowest_modes::LowestModes;
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{
-    Body, BodyOptions, InterfaceSets, MeshData, ModeCount, NodeSet, Patches, Reduction,
+    Body, BodyOptions, InterfaceSets, LinearPlacement, MeshData, ModeCount, NodeSet, Patches,
+    Reduction,
 };
 use crate::error::{Error, Result};
 use crate::fem::nonlinear::SvkSolid;
@@ -38,6 +39,9 @@ pub struct Features {
     /// The slabs were tried and the communication step did not converge with them: the body
     /// keeps its one frame (`Slave::do_step`).
     pub frames_refused: bool,
+    /// The linear body (docs/formulation.md, "The linear body"): the frame held at the
+    /// placement, [`Model::parked_linear`].
+    pub linear: bool,
 }
 
 /// The assembled model for one set of parameters.
@@ -68,6 +72,9 @@ pub(super) struct Model {
     /// [`Features::frames`]); `None`: the body gets none (several frames given, the full
     /// formulation, a reduced body, or no accuracy to decide by).
     pub(super) parked_patches: Option<Patches>,
+    /// The linear body's placement while the frame follows the body ([`Features::linear`]
+    /// off; it moves to `body.linear` and back: no allocation); set at initialization.
+    pub(super) parked_linear: Option<LinearPlacement>,
     /// The body's lowest elastic modes on its supports (of a body without supports: its lowest
     /// elastic ones), for the error control (`slave::step_control`): the period `T₁ = 2π/ω₁`
     /// over which it lets the errors add up to `model.accuracy`, the quasi-static displacement
@@ -85,6 +92,9 @@ impl Model {
     /// the fixed-point/Anderson iteration; so a switch never refactorises.
     pub(super) fn apply_features(&mut self, features: Features) {
         self.body.options.nonlinear_forces = features.nonlinear_forces;
+        if features.linear != self.body.linear.is_some() {
+            std::mem::swap(&mut self.body.linear, &mut self.parked_linear);
+        }
         let slabs = self.body.patches.is_some();
         if self.allowed.frames && features.frames != slabs {
             std::mem::swap(&mut self.body.patches, &mut self.parked_patches);
@@ -95,6 +105,15 @@ impl Model {
                 &mut self.forces.geometric_stiffness,
                 &mut self.parked_geometric_stiffness,
             );
+        }
+    }
+
+    /// Parks the linear body's placement, the best-fit frame of `positions` (the body placed
+    /// rigidly), if the body may be linear; [`Self::apply_features`] puts it in force.
+    pub(super) fn place_linear_body(&mut self, positions: &[f64]) {
+        if self.allowed.linear {
+            self.body.linear = None;
+            self.parked_linear = Some(self.body.linear_placement(positions));
         }
     }
 
@@ -482,6 +501,7 @@ impl Slave {
             stiffening: stiffening.is_some(),
             frames: auto_slabs,
             frames_refused: false,
+            linear: self.linear_allowed()?,
         };
         let indicators = self.feature_indicators(&body, &free, stiffening.as_ref(), allowed);
         // f_nl is switched only on a body without supports; with supports and one frame
@@ -536,6 +556,7 @@ impl Slave {
             allowed,
             parked_geometric_stiffness: None,
             parked_patches,
+            parked_linear: None,
             lowest_modes,
             jacobian: None,
         });

@@ -4,6 +4,7 @@ use super::assembly::Model;
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
 use crate::model::category;
+use nalgebra::Vector3;
 
 /// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
 /// finite number: the state's byte form holds finite numbers only).
@@ -22,6 +23,7 @@ pub(super) fn choose_features(
     dynamics: &mut Dynamics,
     target: f64,
     accuracy: f64,
+    decide_linear: bool,
     events: &mut Vec<LogEvent>,
     scratch: &mut [f64],
 ) {
@@ -79,7 +81,7 @@ pub(super) fn choose_features(
                 });
             }
         };
-        let [quiet_nl, quiet_stiffening] = &mut dynamics.quiet_since;
+        let [quiet_nl, quiet_stiffening, _] = &mut dynamics.quiet_since;
         // On a body with supports (the ones whose f_nl has an estimate) and one co-moving frame
         // f_nl is kept off: on B3 it moved the peak 9 % away from the full reference, where
         // leaving it off stays within 1.6 % (docs/fmu.md, "Which terms a scene needs"). Only a
@@ -102,7 +104,117 @@ pub(super) fn choose_features(
         dynamics.features = f;
     }
     choose_slabs(model, dynamics, accuracy, events, scratch);
+    if decide_linear {
+        choose_linear(model, dynamics, accuracy, events);
+    }
     model.apply_features(dynamics.features);
+}
+
+/// The linear body's frame is held while its rotation `θ` against the placement is at most
+/// this times `model.accuracy`: the linear body differs from the reduced-strain body by about a
+/// third of `θ` relative to the deformation (B1 under a tip step load: 0.34 θ at 1 N and 10 N,
+/// `tests/linear_body.rs`), and a switch applies the difference of their elastic forces as a
+/// step load whose response can be twice that: about `0.7 θ` in all (docs/formulation.md, "The
+/// linear body").
+pub(super) const LINEAR_AT: f64 = 1.0;
+
+/// The rotation `θ` (rad) of the best-fit frame of positions `x` against the linear body's
+/// placement (`None` for a body that cannot be linear).
+fn frame_turn(model: &Model, x: &[f64]) -> Option<f64> {
+    let placement = model
+        .body
+        .linear
+        .as_ref()
+        .or(model.parked_linear.as_ref())?;
+    let rotation = model.body.frame_weights.best_fit(x).rotation;
+    let turn = placement.frame.rotation.transpose() * rotation;
+    let axis = Vector3::new(
+        turn[(2, 1)] - turn[(1, 2)],
+        turn[(0, 2)] - turn[(2, 0)],
+        turn[(1, 0)] - turn[(0, 1)],
+    );
+    // θ from sin θ = |axis| / 2 (well conditioned at small angles), and past π/2 from cos θ.
+    let cos = 0.5 * (turn.trace() - 1.0);
+    Some((0.5 * axis.norm()).atan2(cos))
+}
+
+/// After a communication step taken with `model.auto`'s linear body: the frame's rotation `θ`
+/// at its end if it went beyond the linear body's reach (then the step is redone with the
+/// frame following, `Slave::do_step`: a load that arrived during the step was not foreseen
+/// at its start).
+pub(super) fn linear_reach_exceeded(model: &Model, x: &[f64], accuracy: f64) -> Option<f64> {
+    if !model.allowed.linear || model.body.linear.is_none() {
+        return None;
+    }
+    frame_turn(model, x).filter(|&theta| theta > LINEAR_AT * accuracy)
+}
+
+/// `model.auto`'s linear body (docs/formulation.md, "The linear body"), for a body held by
+/// fixed supports: linear (the frame held at the placement, one linear solve per step) while
+/// the rotation `θ` of its best-fit frame against the placement stays at most [`LINEAR_AT`] ×
+/// `model.accuracy`; the frame follows the body from the first communication point where it
+/// does not, and is held again once `θ` has stayed below [`feature_indicators::HYSTERESIS`]
+/// times that for one period `2π/ω₁` of the lowest mode. Each switch is logged; it needs no
+/// state transfer and no factorization (the same `K`, `M` and iteration matrix). The slabs
+/// (a body that bends far) end it for good.
+fn choose_linear(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    accuracy: f64,
+    events: &mut Vec<LogEvent>,
+) {
+    if !model.allowed.linear {
+        return;
+    }
+    let f = &mut dynamics.features;
+    let s = &dynamics.state;
+    let Some(theta) = frame_turn(model, &s.position) else {
+        return;
+    };
+    let limit = LINEAR_AT * accuracy;
+    let dwell = model
+        .lowest_modes
+        .as_ref()
+        .map_or(0.0, |m| m.first_period());
+    let quiet = &mut dynamics.quiet_since[2];
+    let next = if f.frames {
+        false
+    } else if f.linear {
+        theta <= limit
+    } else if theta <= feature_indicators::HYSTERESIS * limit {
+        if *quiet == NOT_QUIET {
+            *quiet = s.time;
+        }
+        // (Strictly later: a step redone at the same time stays with the frame following.)
+        s.time - *quiet >= dwell.max(f64::MIN_POSITIVE)
+    } else {
+        *quiet = NOT_QUIET;
+        false
+    };
+    if next != f.linear {
+        f.linear = next;
+        *quiet = NOT_QUIET;
+        if next {
+            f.nonlinear_forces = false;
+        }
+        events.push(LogEvent {
+            category: category::EVENTS,
+            message: if next {
+                format!(
+                    "model.auto: at t = {} the body is linear again: its frame has turned {theta:.3e} rad from its placement, below {} × {LINEAR_AT} × model.accuracy = {:.3e} since t = {} (at least one period 2π/ω₁ = {dwell:.3e} s); one linear solve per step",
+                    s.time,
+                    feature_indicators::HYSTERESIS,
+                    feature_indicators::HYSTERESIS * limit,
+                    s.time - dwell.min(s.time)
+                )
+            } else {
+                format!(
+                    "model.auto: at t = {} the body's frame follows it: it has turned {theta:.3e} rad from its placement, more than {LINEAR_AT} × model.accuracy = {limit:.3e} (the linear body's error is about half of it)",
+                    s.time
+                )
+            },
+        });
+    }
 }
 
 /// The single frame's error on a body that bends far, in units of the largest deformation

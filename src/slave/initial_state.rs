@@ -38,6 +38,8 @@ impl Slave {
         let model = self.model.as_mut().unwrap();
         // model.auto starts with the terms that have an estimate off (the body is placed
         // rigidly: ū = 0, where both vanish); without it the switches are forced.
+        // The linear body starts linear when allowed (placed rigidly, its frame is at the
+        // placement); its placement is known once the body is placed, below.
         let features = match &model.indicators {
             Some(ind) => Features {
                 nonlinear_forces: model.allowed.nonlinear_forces
@@ -45,13 +47,21 @@ impl Slave {
                 stiffening: model.allowed.stiffening && !ind.estimates_stiffening(),
                 frames: false,
                 frames_refused: false,
+                linear: false,
             },
             None => Features {
                 frames: false,
+                linear: false,
                 ..model.allowed
             },
         };
         model.apply_features(features);
+        let features = Features {
+            linear: model.allowed.linear,
+            // f_nl belongs to the frame that follows the body.
+            nonlinear_forces: features.nonlinear_forces && !model.allowed.linear,
+            ..features
+        };
         let body = &model.body;
         let n = body.node_count();
         let mut state = DynamicState {
@@ -90,6 +100,8 @@ impl Slave {
         );
         self.hold_point_constraints(&state, &placement)?;
         let model = self.model.as_mut().unwrap();
+        model.place_linear_body(&state.position);
+        model.apply_features(features);
         let body = &model.body;
         let gravity = Vector3::from(self.parameters.gravity);
         let interfaces = &self.interfaces;
@@ -113,7 +125,7 @@ impl Slave {
             loads: self.inputs.clone(),
             gravity: self.parameters.gravity,
             features,
-            quiet_since: [NOT_QUIET; 2],
+            quiet_since: [NOT_QUIET; 3],
             ladder: Ladder::default(),
             deformation_scale: 0.0,
             high_mode_scale: 0.0,
@@ -121,6 +133,24 @@ impl Slave {
         });
         self.outputs.valid = false;
         Ok(())
+    }
+
+    /// The positions of the body at its rigid placement ([`Self::rigid_placement`]); allocates.
+    pub(super) fn rigid_placement_positions(&self) -> Result<Vec<f64>> {
+        let placement = self.rigid_placement()?;
+        let body = &self.model.as_ref().expect("a model").body;
+        let n3 = 3 * body.node_count();
+        let (mut x, mut v) = (vec![0.0; n3], vec![0.0; n3]);
+        body.place_rigidly(
+            &placement.origin,
+            &placement.rotation,
+            &placement.anchor,
+            &Vector3::zeros(),
+            &Vector3::zeros(),
+            &mut x,
+            &mut v,
+        );
+        Ok(x)
     }
 
     /// The rigid placement from the first motion interface's driving frame, or from the

@@ -188,6 +188,9 @@ pub(super) fn apply_loads(
     if gravity.norm_squared() > 0.0 {
         body.add_uniform_acceleration_load(gravity, f);
     }
+    // A linear body's loads act on its placement, as its elastic force does (docs/formulation.md,
+    // "The linear body"): they do not follow the deformation.
+    let x = body.linear.as_ref().map_or(x, |l| &l.positions[..]);
     for (k, (interface, input)) in interfaces.iter().zip(inputs).enumerate() {
         if interface.kind != InterfaceKind::Force {
             continue;

@@ -74,7 +74,7 @@ struct Dynamics {
     features: Features,
     /// Per term (f_nl, stiffening): since when its estimate has stayed below the switch-off
     /// threshold while it is on ([`NOT_QUIET`]: it has not), see [`choose_features`].
-    quiet_since: [f64; 2],
+    quiet_since: [f64; 3],
     /// The rung `k` of the internal step `solver.stepSize / 2^k` for the next communication
     /// step, and when the rung above is next probed ([`step_control`]).
     ladder: Ladder,
@@ -560,6 +560,11 @@ impl Slave {
                 d.estimate_floor = s.estimate_floor;
             }
             (d, s) => *d = s.clone(),
+        }
+        if self.dynamics.is_some() && self.model.as_ref().is_some_and(|m| m.allowed.linear) {
+            // The linear body's placement (a rebuilt model has none yet).
+            let x0 = self.rigid_placement_positions()?;
+            self.model.as_mut().unwrap().place_linear_body(&x0);
         }
         if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
             model.apply_features(d.features);

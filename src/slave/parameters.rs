@@ -30,6 +30,8 @@ pub struct Parameters {
     pub accuracy: f64,
     pub max_iterations: i32,
     pub nonlinear_forces: bool,
+    /// `model.linear`: the linear body forced (docs/formulation.md, "The linear body").
+    pub linear: bool,
     /// `model.auto`: with it `nonlinear_forces` and `stiffening` are what is allowed and the
     /// slave switches each on per step when its indicator says it matters (see [`Features`]).
     pub auto: bool,
@@ -87,6 +89,7 @@ impl Parameters {
             accuracy: b.model.accuracy,
             max_iterations: b.solver.max_iterations.min(i32::MAX as u32) as i32,
             nonlinear_forces: b.model.nonlinear_forces,
+            linear: b.model.linear,
             auto: b.model.auto,
             formulation: Formulation::default(),
             stiffening: Stiffening::default(),
@@ -107,6 +110,7 @@ impl Parameters {
             damping: [self.damping_alpha.to_bits(), self.damping_beta.to_bits()],
             rho_inf: self.rho_inf.to_bits(),
             nonlinear_forces: self.nonlinear_forces,
+            linear: self.linear,
             auto: self.auto,
             formulation: self.formulation,
             stiffening: self.stiffening,
@@ -151,6 +155,7 @@ pub(super) struct AssemblyKey {
     damping: [u64; 2],
     rho_inf: u64,
     nonlinear_forces: bool,
+    linear: bool,
     auto: bool,
     formulation: Formulation,
     stiffening: Stiffening,
@@ -234,6 +239,7 @@ macro_rules! parameter_slot {
             AndersonDepth => Slot::Integer(&$($m)? $p.anderson_depth),
             Integrator => Slot::Choice(&$($m)? $p.integrator),
             NonlinearForces => Slot::Boolean(&$($m)? $p.nonlinear_forces),
+            Linear => Slot::Boolean(&$($m)? $p.linear),
             Auto => Slot::Boolean(&$($m)? $p.auto),
             OutputDirectory => Slot::Text(&$($m)? $p.output_directory),
             _ => return None,

@@ -180,6 +180,7 @@ impl SlaveState {
         w.i32(p.modes);
         w.u8(u8::from(p.nonlinear_forces));
         w.u8(u8::from(p.auto));
+        w.u8(u8::from(p.linear));
         self.inputs.iter().for_each(|i| w.f64s(i));
         for d in &self.input_derivatives {
             w.f64s(&d[0]);
@@ -213,7 +214,8 @@ impl SlaveState {
                 w.u8(u8::from(d.features.nonlinear_forces)
                     | u8::from(d.features.stiffening) << 1
                     | u8::from(d.features.frames) << 2
-                    | u8::from(d.features.frames_refused) << 3);
+                    | u8::from(d.features.frames_refused) << 3
+                    | u8::from(d.features.linear) << 4);
                 w.f64s(&d.quiet_since);
                 w.u32(d.ladder.level);
                 w.u32(d.ladder.calm_steps);
@@ -341,6 +343,15 @@ impl Slave {
                 )))
             }
         };
+        p.linear = match r.u8("model.linear")? {
+            0 => false,
+            1 => true,
+            b => {
+                return Err(Error::new(format!(
+                    "the serialized FMU state holds {b} for model.linear: not a Boolean"
+                )))
+            }
+        };
         check_parameters(&p)?;
         Ok(p)
     }
@@ -402,19 +413,20 @@ impl Slave {
                 let mut gravity = [0.0; 3];
                 r.f64s(&mut gravity, "the gravity of the state")?;
                 let features = match r.u8("the terms in force")? {
-                    b @ 0..=15 => super::Features {
+                    b @ 0..=31 => super::Features {
                         nonlinear_forces: b & 1 != 0,
                         stiffening: b & 2 != 0,
                         frames: b & 4 != 0,
                         frames_refused: b & 8 != 0,
+                        linear: b & 16 != 0,
                     },
                     b => {
                         return Err(Error::new(format!(
-                            "the serialized FMU state holds {b} for the terms in force: not 0 to 15"
+                            "the serialized FMU state holds {b} for the terms in force: not 0 to 31"
                         )))
                     }
                 };
-                let mut quiet_since = [0.0; 2];
+                let mut quiet_since = [0.0; 3];
                 r.f64s(
                     &mut quiet_since,
                     "the times since the terms' indicators are quiet",

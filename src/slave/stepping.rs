@@ -1,6 +1,6 @@
 //! `fmi2DoStep`: a communication step as internal steps, with halving retries and rollback.
 
-use super::auto_features::choose_features;
+use super::auto_features::{choose_features, linear_reach_exceeded, LINEAR_AT, NOT_QUIET};
 use super::interfaces::extrapolate;
 use super::step_control::{
     finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
@@ -124,6 +124,38 @@ impl Slave {
                         "model.auto: the step from t = {t0} did not converge with the slabs {} ({}); redone with the one co-moving frame, which the body keeps",
                         if slabs_before { "on" } else { "switched on" },
                         result.unwrap_err().message
+                    ),
+                });
+                before.restore_scales(self.dynamics.as_mut().unwrap());
+                continue;
+            }
+            let decides_linear = self.parameters.auto && !self.parameters.linear;
+            let beyond = result.is_ok() && decides_linear;
+            let beyond = beyond
+                .then(|| {
+                    linear_reach_exceeded(
+                        self.model.as_ref().unwrap(),
+                        &self.dynamics.as_ref().unwrap().state.position,
+                        self.parameters.accuracy,
+                    )
+                })
+                .flatten();
+            if let Some(theta) = beyond {
+                // The linear body went beyond its reach during the step (a load that came
+                // with it): the step is redone with the frame following the body.
+                let dynamics = self.dynamics.as_mut().unwrap();
+                dynamics.state.copy_from(self.backup.as_ref().unwrap());
+                dynamics.features.linear = false;
+                dynamics.quiet_since[2] = NOT_QUIET;
+                self.model
+                    .as_mut()
+                    .unwrap()
+                    .apply_features(dynamics.features);
+                self.events.push(LogEvent {
+                    category: category::EVENTS,
+                    message: format!(
+                        "model.auto: the step from t = {t0} turned the linear body's frame {theta:.3e} rad from its placement, more than {LINEAR_AT} × model.accuracy = {:.3e}; redone with the frame following the body",
+                        LINEAR_AT * self.parameters.accuracy
                     ),
                 });
                 before.restore_scales(self.dynamics.as_mut().unwrap());
@@ -381,6 +413,7 @@ impl Slave {
             dynamics,
             self.parameters.tolerance * self.size,
             self.parameters.accuracy,
+            self.parameters.auto && !self.parameters.linear,
             &mut self.events,
             &mut self.scale_scratch,
         );
@@ -532,7 +565,7 @@ struct StepStart {
     high_mode_scale: f64,
     estimate_floor: f64,
     features: super::Features,
-    quiet_since: [f64; 2],
+    quiet_since: [f64; 3],
 }
 
 impl StepStart {

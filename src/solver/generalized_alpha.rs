@@ -89,6 +89,38 @@ pub struct IterationMatrix {
     newton: Option<TangentMatrix>,
     /// With `f_nl`: the rank-3 Woodbury correction of its Jacobian.
     nonlinear: Option<NonlinearForceCorrection>,
+    /// `ρ`, the forward error of a solve relative to its solution ([`forward_error_ratio`]):
+    /// what a linear body's first correction leaves (docs/formulation.md, "The linear body").
+    linear_error_ratio: f64,
+}
+
+/// A linear step stops after its first correction `Δx₁` when `LINEAR_SAFETY × ρ × |Δx₁|` is
+/// within the iteration's tolerance (`ρ`: [`forward_error_ratio`]): the forward error of the
+/// solve, about `cond(S̄) ε` of the correction, depends on the right-hand side; a tenth of the
+/// tolerance covers its spread.
+pub const LINEAR_SAFETY: f64 = 10.0;
+
+/// `ρ = |δ|∞ / |x|∞` for `x = S̄⁻¹ b` and its correction `δ = S̄⁻¹ (b − S̄ x)`, on a right-hand
+/// side `b` with a part in every direction (a low-discrepancy sequence in `[−½, ½]`): the
+/// forward error of one solve with `factor` relative to its solution, rounding of the residual
+/// included (docs/formulation.md, "The linear body"). The same for every run at this matrix,
+/// so a run repeats bit for bit. Allocates (once per factorization).
+fn forward_error_ratio(
+    s: &SymmetricCsr,
+    factor: &SparseCholesky,
+    workspace: &mut SolveWorkspace,
+) -> f64 {
+    let b: Vec<f64> = (0..s.n)
+        .map(|i| (i as f64 * 0.618_033_988_749_895).fract() - 0.5)
+        .collect();
+    let mut x = b.clone();
+    factor.solve_in_place(&mut x, workspace);
+    let mut r = vec![0.0; s.n];
+    s.mul_vec(&x, &mut r);
+    r.iter_mut().zip(&b).for_each(|(r, b)| *r = b - *r);
+    factor.solve_in_place(&mut r, workspace);
+    let largest = |v: &[f64]| v.iter().fold(0.0_f64, |m, a| m.max(a.abs()));
+    largest(&r) / largest(&x).max(f64::MIN_POSITIVE)
 }
 
 /// Newton's iteration matrix of the full formulation, `S = c_m' M + c_k K_T(x)` on the free DOFs
@@ -234,6 +266,7 @@ impl IterationMatrix {
         let nonlinear = ((body.options.nonlinear_forces || body.nonlinear_forces_switchable)
             && body.single_frame())
         .then(|| NonlinearForceCorrection::new(body, free, &factor, &mut workspace));
+        let linear_error_ratio = forward_error_ratio(&s, &factor, &mut workspace);
         Ok(IterationMatrix {
             step_size: h,
             scheme: *scheme,
@@ -243,6 +276,7 @@ impl IterationMatrix {
             constraint,
             newton,
             nonlinear,
+            linear_error_ratio,
         })
     }
 }
@@ -344,6 +378,12 @@ fn iterate(
     predict(&scheme, problem, h, &ws.previous, state);
     let mut convergence = Convergence::new("", settings, state.time, h);
     ws.anderson.reset();
+    // A linear body's step is linear with the iteration matrix as its exact Jacobian: the
+    // first correction solves it, up to the solve's forward error (docs/formulation.md, "The
+    // linear body").
+    let linear = body.steps_linearly(forces.geometric_stiffness.is_some())
+        && matrix.constraint.is_none()
+        && matrix.newton.is_none();
     for iteration in 1..=settings.max_iterations {
         let kin = residual(body, free, state, loads, forces);
         if iteration == 1 {
@@ -351,13 +391,21 @@ fn iterate(
         }
         let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
         let largest = matrix.plain_update(body, free, &frame, state, ws, forces);
-        let converged = convergence.converged(largest)?;
+        let solved = linear
+            && iteration == 1
+            && LINEAR_SAFETY * matrix.linear_error_ratio * largest <= settings.absolute_tolerance;
+        let converged = convergence.converged(largest)? || solved;
         if matrix.newton.is_none() {
             mix_update(&mut ws.anderson, converged, &ws.iterate, &mut ws.update);
         }
         apply_update(&scheme, h, free, state, ws);
         if converged {
             update_pseudo_acceleration(&scheme, free, &ws.previous, state);
+            if iteration == 1 && settings.estimate_error.is_some() {
+                // The error control reads the deformation from the last residual's scratch:
+                // the end of the step's, not the predictor's (a linear step stops at once).
+                residual(body, free, state, loads, forces);
+            }
             let error_estimate = settings
                 .estimate_error
                 .map(|enough| matrix.local_error(body, free, &frame, state, ws, forces, enough));

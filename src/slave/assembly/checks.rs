@@ -185,4 +185,42 @@ impl Slave {
         }
         Ok(())
     }
+
+    /// Whether the body may be linear (docs/formulation.md, "The linear body"): forced by
+    /// `model.linear`, or left to `model.auto` with `model.accuracy > 0` (generalized-α, neither
+    /// `f_nl` nor stiffening allowed). Only a
+    /// body held by fixed supports, nothing driving or pinning it, reduced strain with one
+    /// frame: a body that moves or turns needs its frame to follow it. `model.linear` on any
+    /// other body is an error naming the reason.
+    pub(in crate::slave) fn linear_allowed(&self) -> Result<bool> {
+        let p = &self.parameters;
+        let has = |kind: InterfaceKind| self.interfaces.iter().any(|i| i.kind == kind);
+        let reason = if has(InterfaceKind::Motion) {
+            Some("a motion interface moves the body (its frame must follow it)")
+        } else if has(InterfaceKind::Pin) || has(InterfaceKind::Hinge) {
+            Some("a pin or hinge lets the body turn (its frame must follow it)")
+        } else if self.rigid_attachments().iter().any(|&r| r) {
+            Some("its rigid attachments' constraints are geometrically exact, which the linear body is not (and its steps iterate on them anyway)")
+        } else if !has(InterfaceKind::Fixed) {
+            Some("the body has no fixed support (a free body turns: its frame must follow it)")
+        } else if p.formulation == Formulation::Full {
+            Some("model.formulation = full is the geometrically exact body")
+        } else if p.frames > 1 {
+            Some("model.frames > 1: the slabs' frames follow the body")
+        } else {
+            None
+        };
+        match (p.linear, reason) {
+            (true, Some(reason)) => Err(Error::invalid_value("model.linear", "true", reason)),
+            (true, None) => Ok(true),
+            (false, Some(_)) => Ok(false),
+            // Allowing f_nl or stiffening asks for the geometric effects the linear body
+            // leaves out: model.auto does not take it then.
+            (false, None) => Ok(p.auto
+                && p.accuracy > 0.0
+                && p.integrator == Integrator::GeneralizedAlpha
+                && !p.nonlinear_forces
+                && p.stiffening == Stiffening::None),
+        }
+    }
 }
