@@ -460,6 +460,7 @@ impl Slave {
         let p = &self.parameters;
         // model.auto's slabs: built now, with the force scratch that serves them, and parked.
         let auto_slabs = p.auto
+            && !p.linear
             && p.accuracy > 0.0
             && p.integrator == Integrator::GeneralizedAlpha
             && body.single_frame()

@@ -209,7 +209,7 @@ fn choose_linear(
                 )
             } else {
                 format!(
-                    "model.auto: at t = {} the body's frame follows it: it has turned {theta:.3e} rad from its placement, more than {LINEAR_AT} × model.accuracy = {limit:.3e} (the linear body's error is about half of it)",
+                    "model.auto: at t = {} the body's frame follows it: it has turned {theta:.3e} rad from its placement, more than {LINEAR_AT} × model.accuracy = {limit:.3e} (the linear body's error is about a third of it)",
                     s.time
                 )
             },

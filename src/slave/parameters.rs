@@ -103,7 +103,8 @@ impl Parameters {
     }
 
     /// The parameters that the assembled model depends on (everything but gravity, the initial
-    /// placement, the step size and the iteration settings).
+    /// placement, the step size, the iteration settings and the value of a positive
+    /// `model.accuracy`).
     pub(super) fn assembly_key(&self) -> AssemblyKey {
         AssemblyKey {
             material: self.material,
@@ -112,6 +113,7 @@ impl Parameters {
             nonlinear_forces: self.nonlinear_forces,
             linear: self.linear,
             auto: self.auto,
+            controlled: self.accuracy > 0.0,
             formulation: self.formulation,
             stiffening: self.stiffening,
             frames: self.frames,
@@ -157,6 +159,9 @@ pub(super) struct AssemblyKey {
     nonlinear_forces: bool,
     linear: bool,
     auto: bool,
+    /// `model.accuracy > 0`: the model carries the lowest modes of the error control and
+    /// `model.auto`'s slabs and linear body are decided against it.
+    controlled: bool,
     formulation: Formulation,
     stiffening: Stiffening,
     frames: i32,

@@ -454,6 +454,16 @@ impl Slave {
             extrapolate(load, d, age + big_h);
         }
         dynamics.gravity = self.parameters.gravity;
+        if let Some(model) = self.model.as_mut().filter(|m| {
+            m.body.linear.is_some() && (m.lowest_modes.is_some() || m.strain_monitor.is_some())
+        }) {
+            // A linear step stops at its first correction: the scratch holds its predictor's
+            // deformation, which the deformation scale and the strain watch must not read.
+            let state = &self.dynamics.as_ref().unwrap().state;
+            model
+                .forces
+                .observe(&model.body, state, &mut self.scale_scratch);
+        }
         if let Some(modes) = self.model.as_ref().and_then(|m| m.lowest_modes.as_ref()) {
             let model = self.model.as_ref().unwrap();
             let dynamics = self.dynamics.as_mut().unwrap();

@@ -331,6 +331,20 @@ impl ResidualWorkspace {
     pub fn force_scratch(&self) -> &ForceScratch {
         &self.force_scratch
     }
+
+    /// Evaluates the internal force at `state` into `force` (full `3N`), so that the force
+    /// scratch holds that state's `ū` and `g`: after a linear step, which stops at its first
+    /// correction with the predictor's in it (docs/formulation.md, "The linear body"). The last
+    /// residual's vectors are left alone. No allocation.
+    pub fn observe(&mut self, body: &Body, state: &DynamicState, force: &mut [f64]) {
+        body.internal_force(
+            &state.position,
+            &state.velocity,
+            self.geometric_stiffness.as_ref(),
+            &mut self.force_scratch,
+            force,
+        );
+    }
 }
 
 /// The residual `r = M ẍ + f(x, ẋ) + Cᵀλ − f_ext(x)` (full `3N`, in `ws`, read it with

@@ -210,7 +210,15 @@ impl Slave {
         } else {
             None
         };
-        match (p.linear, reason) {
+        // What the linear body cannot carry, when it is forced.
+        let conflict = if p.nonlinear_forces && !p.auto {
+            Some("model.nonlinearForces = true forces f_nl, which belongs to a frame that follows the body")
+        } else if p.stiffening != Stiffening::None {
+            Some("model.stiffening is the prestress of a frame that follows the body (its K_G would be turned by the held frame)")
+        } else {
+            None
+        };
+        match (p.linear, reason.or(conflict)) {
             (true, Some(reason)) => Err(Error::invalid_value("model.linear", "true", reason)),
             (true, None) => Ok(true),
             (false, Some(_)) => Ok(false),
