@@ -138,6 +138,16 @@ impl<'a> Reader<'a> {
     pub(crate) fn u8(&mut self, what: &str) -> Result<u8> {
         Ok(self.take::<1>(what)?[0])
     }
+    /// A Boolean (u8 0 or 1).
+    fn boolean(&mut self, what: &str) -> Result<bool> {
+        match self.u8(what)? {
+            0 => Ok(false),
+            1 => Ok(true),
+            b => Err(Error::new(format!(
+                "the serialized FMU state holds {b} for {what}: not a Boolean"
+            ))),
+        }
+    }
     /// A count that must equal `expected` (a property of this body).
     fn count(&mut self, expected: usize, what: &str) -> Result<()> {
         let n = self.u64(what)?;
@@ -325,33 +335,9 @@ impl Slave {
         p.anderson_depth = r.i32("solver.andersonDepth")?;
         p.integrator = r.choice("solver.integrator", Integrator::from_item)?;
         p.modes = r.i32("model.modes")?;
-        p.nonlinear_forces = match r.u8("model.nonlinearForces")? {
-            0 => false,
-            1 => true,
-            b => {
-                return Err(Error::new(format!(
-                    "the serialized FMU state holds {b} for model.nonlinearForces: not a Boolean"
-                )))
-            }
-        };
-        p.auto = match r.u8("model.auto")? {
-            0 => false,
-            1 => true,
-            b => {
-                return Err(Error::new(format!(
-                    "the serialized FMU state holds {b} for model.auto: not a Boolean"
-                )))
-            }
-        };
-        p.linear = match r.u8("model.linear")? {
-            0 => false,
-            1 => true,
-            b => {
-                return Err(Error::new(format!(
-                    "the serialized FMU state holds {b} for model.linear: not a Boolean"
-                )))
-            }
-        };
+        p.nonlinear_forces = r.boolean("model.nonlinearForces")?;
+        p.auto = r.boolean("model.auto")?;
+        p.linear = r.boolean("model.linear")?;
         check_parameters(&p)?;
         Ok(p)
     }
