@@ -454,11 +454,16 @@ impl Slave {
             extrapolate(load, d, age + big_h);
         }
         dynamics.gravity = self.parameters.gravity;
+        // A linear step stops at its first correction: the scratch holds its predictor's
+        // deformation, which the deformation scale and the strain watch must not read. (An
+        // estimated step has evaluated its end already, and the last of a communication step is
+        // estimated whenever one is.)
+        let stale = self.step_error.is_none();
         if let Some(model) = self.model.as_mut().filter(|m| {
-            m.body.linear.is_some() && (m.lowest_modes.is_some() || m.strain_monitor.is_some())
+            stale
+                && m.body.linear.is_some()
+                && (m.lowest_modes.is_some() || m.strain_monitor.is_some())
         }) {
-            // A linear step stops at its first correction: the scratch holds its predictor's
-            // deformation, which the deformation scale and the strain watch must not read.
             let state = &self.dynamics.as_ref().unwrap().state;
             model
                 .forces
