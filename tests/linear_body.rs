@@ -129,11 +129,7 @@ fn model_auto_keeps_the_body_linear_while_its_frame_turns_little() {
 
 #[test]
 fn model_linear_is_refused_on_a_body_that_moves() {
-    let mut s = Slave::from_body(example_body("hub_beam")).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
-    s.enter_initialization_mode().unwrap();
-    set(&mut s, "model.linear", 1.0);
-    let e = s.exit_initialization_mode().unwrap_err();
+    let e = refused(example_body("hub_beam"), &[("model.linear", 1.0)]);
     assert!(
         e.message.contains("model.linear") && e.message.contains("motion interface"),
         "{}",
@@ -166,14 +162,12 @@ fn model_linear_forced_takes_no_slabs_and_stays_one_solve_per_step() {
 #[test]
 fn model_linear_is_refused_with_what_it_cannot_carry() {
     let refused = |body: flexbody::model::BodyFile, settings: &[(&str, f64)], reason: &str| {
-        let mut s = Slave::from_body(body).unwrap();
-        s.setup_experiment(0.0, None, None).unwrap();
-        s.enter_initialization_mode().unwrap();
-        set(&mut s, "model.linear", 1.0);
-        for (name, value) in settings {
-            set(&mut s, name, *value);
-        }
-        let e = s.exit_initialization_mode().unwrap_err();
+        let settings: Vec<_> = [("model.linear", 1.0)]
+            .iter()
+            .chain(settings)
+            .copied()
+            .collect();
+        let e = refused(body, &settings);
         assert!(
             e.message.contains("model.linear") && e.message.contains(reason),
             "{}",

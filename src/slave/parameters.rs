@@ -69,6 +69,11 @@ impl Parameters {
         }
     }
 
+    /// Whether `model.auto` decides the linear body (it is not forced by `model.linear`).
+    pub(super) fn decides_linear(&self) -> bool {
+        self.auto && !self.linear
+    }
+
     pub(super) fn from_body_file(b: &BodyFile) -> Parameters {
         Parameters {
             material: IsotropicMaterial {

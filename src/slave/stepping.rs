@@ -129,9 +129,7 @@ impl Slave {
                 before.restore_scales(self.dynamics.as_mut().unwrap());
                 continue;
             }
-            let decides_linear = self.parameters.auto && !self.parameters.linear;
-            let beyond = result.is_ok() && decides_linear;
-            let beyond = beyond
+            let beyond = (result.is_ok() && self.parameters.decides_linear())
                 .then(|| {
                     linear_reach_exceeded(
                         self.model.as_ref().unwrap(),
@@ -413,7 +411,7 @@ impl Slave {
             dynamics,
             self.parameters.tolerance * self.size,
             self.parameters.accuracy,
-            self.parameters.auto && !self.parameters.linear,
+            self.parameters.decides_linear(),
             &mut self.events,
             &mut self.scale_scratch,
         );

@@ -49,6 +49,17 @@ pub fn initialized(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
     slave
 }
 
+/// The error with which `body` refuses to leave initialization with `settings`.
+pub fn refused(body: BodyFile, settings: &[(&str, f64)]) -> flexbody::error::Error {
+    let mut slave = Slave::from_body(body).unwrap();
+    slave.setup_experiment(0.0, None, None).unwrap();
+    slave.enter_initialization_mode().unwrap();
+    for (name, value) in settings {
+        set(&mut slave, name, *value);
+    }
+    slave.exit_initialization_mode().unwrap_err()
+}
+
 /// The default body (B1), initialized with `settings`.
 pub fn initialized_default(settings: &[(&str, f64)]) -> Slave {
     initialized(BodyFile::default_body(), settings)
