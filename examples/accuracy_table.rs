@@ -70,9 +70,11 @@ impl Run {
     }
 }
 
-fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
+/// A slave of `body` set up for a run from 0 to `end` (s), as an importer sets it up (the stop
+/// time defined: the time error control's horizon), with `settings` by name.
+fn slave(body: BodyFile, settings: &[(&str, f64)], end: f64) -> Slave {
     let mut s = Slave::from_body(body).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
+    s.setup_experiment(0.0, Some(end), None).unwrap();
     s.enter_initialization_mode().unwrap();
     for &(name, value) in settings {
         s.set_by_name(name, value).unwrap();
@@ -81,7 +83,7 @@ fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
 }
 
 fn b1(settings: &[(&str, f64)], end: f64) -> Run {
-    let mut s = slave(BodyFile::default_body(), settings);
+    let mut s = slave(BodyFile::default_body(), settings, end);
     s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
     s.exit_initialization_mode().unwrap();
     let tip = vr(&s, "tip.position[2]");
@@ -99,7 +101,7 @@ fn b1(settings: &[(&str, f64)], end: f64) -> Run {
 
 fn b3(settings: &[(&str, f64)], end: f64, dt: f64) -> Run {
     let text = std::fs::read_to_string("examples/hub_beam.json").unwrap();
-    let mut s = slave(BodyFile::from_json(&text).unwrap(), settings);
+    let mut s = slave(BodyFile::from_json(&text).unwrap(), settings, end);
     s.exit_initialization_mode().unwrap();
     let drive = b3::HubDrive::new(&s);
     let n = (end / dt).round() as usize;
@@ -116,7 +118,7 @@ fn b3(settings: &[(&str, f64)], end: f64, dt: f64) -> Run {
 /// 0.1 ms for `end` s; the samples are the small eye's x displacement (m).
 fn conrod(settings: &[(&str, f64)], end: f64) -> Run {
     let mut s = Slave::from_body_path(std::path::Path::new("examples/conrod.json")).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
+    s.setup_experiment(0.0, Some(end), None).unwrap();
     s.enter_initialization_mode().unwrap();
     for &(name, value) in settings {
         s.set_by_name(name, value).unwrap();
@@ -153,7 +155,7 @@ fn b2(settings: &[(&str, f64)], end: f64) -> Run {
     let mut file = BodyFile::from_json(&text).unwrap();
     let tip = r#"{ "name": "tip", "kind": "force", "nodes": { "plane": { "point": [1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } }, "referencePoint": [1.0, 0.0, 0.0] }"#;
     file.interfaces.push(serde_json::from_str(tip).unwrap());
-    let mut s = slave(file, settings);
+    let mut s = slave(file, settings, end);
     let w = nalgebra::Vector3::new(0.5, 3.0, 7.0);
     let v = -w.cross(&nalgebra::Vector3::new(0.5, 0.0, 0.0));
     for k in 0..3 {
@@ -462,7 +464,8 @@ fn b2_section(quick: bool) {
     let end = if quick { 0.2 } else { 1.0 };
     // The default model at a fine step: the reference of the time error (what model.accuracy
     // controls); `full` at a fine step: the reference of the model's own error.
-    let h_ref = 1e-3 / 64.0;
+    // 1 ms / 256: a quarter of the finest step model.accuracy = 1e-4 takes.
+    let h_ref = 1e-3 / 256.0;
     let reference = b2(&[("solver.stepSize", h_ref), ("model.accuracy", 0.0)], end).samples;
     let h_full = 1e-3 / 32.0;
     let full = b2(
@@ -484,7 +487,7 @@ fn b2_section(quick: bool) {
     let divisions: &[u32] = if quick {
         &[1, 4]
     } else {
-        &[1, 2, 4, 8, 16, 32]
+        &[1, 2, 4, 8, 16, 32, 64, 128]
     };
     let steps: Vec<f64> = divisions.iter().map(|&d| 1e-3 / f64::from(d)).collect();
     let hand = fixed_step_rows(&steps, &reference, |h| {

@@ -382,9 +382,9 @@ fn a_discarded_step_leaves_the_whole_state_as_it_was() {
     let after = bytes(&s);
     // The counters' place (src/slave/state_bytes.rs): format and interface count (8 bytes), the
     // parameters (270), per interface its inputs, derivatives, sample time and driving frame
-    // (872), the last step size and the start time (16); four u64 counters.
+    // (872), the last step size and the start time (16), the stop time (9); four u64 counters.
     let n = 2;
-    let counters = 294 + 872 * n..294 + 872 * n + 32;
+    let counters = 303 + 872 * n..303 + 872 * n + 32;
     assert_eq!(after.len(), before.len());
     let differ: Vec<usize> = (0..after.len())
         .filter(|&i| after[i] != before[i])
@@ -428,4 +428,115 @@ fn a_discarded_step_changes_nothing_that_follows() {
         "internal steps after the discarded one"
     );
     assert!(tried == twin, "the discarded step changed what follows");
+}
+
+/// The errors of a run add up over the run (docs/formulation.md, "The horizon"): the undamped
+/// beam rings for 0.5 s, about 8 periods of its first mode. With the stop time defined, as
+/// importers define it, the control holds `model.accuracy` over the whole run; without, it holds
+/// it per period `T₁`, and the phase error of the ringing goes on adding up past it. The
+/// reference is the fixed step 2e-5 s (its own error, by the fixed-step rows of the accuracy
+/// report's B1, below 1e-3 of the peak).
+#[test]
+fn the_errors_add_up_over_the_run_when_its_stop_time_is_known() {
+    let end = 0.5;
+    let run = |stop: Option<f64>, settings: &[(&str, f64)]| {
+        let mut s = Slave::from_body(body()).unwrap();
+        s.setup_experiment(0.0, stop, None).unwrap();
+        s.enter_initialization_mode().unwrap();
+        s.set_by_name("solver.stepSize", H).unwrap();
+        for &(name, value) in settings {
+            s.set_by_name(name, value).unwrap();
+        }
+        s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
+        s.exit_initialization_mode().unwrap();
+        let horizon = s
+            .drain_events()
+            .find(|e| e.message.contains("errors that last"))
+            .map(|e| e.message);
+        let history = tip_history(&mut s, end);
+        (history, s.solver_statistics().0, horizon)
+    };
+    let (reference, _, _) = run(
+        Some(end),
+        &[("model.accuracy", 0.0), ("solver.stepSize", 2e-5)],
+    );
+    let peak = peak(&reference);
+    let accuracy = 1e-2;
+    let (per_run, run_steps, said) = run(Some(end), &[("model.accuracy", accuracy)]);
+    let (per_period, period_steps, said_period) = run(None, &[("model.accuracy", accuracy)]);
+    let run_error = largest_difference(&per_run, &reference) / peak;
+    let period_error = largest_difference(&per_period, &reference) / peak;
+    println!(
+        "over the run: {run_steps} internal steps, error {run_error:.3e} of the peak; per period: {period_steps}, {period_error:.3e}"
+    );
+    assert!(
+        said.is_some_and(|m| m.contains("over the run, stopTime − startTime = 5.0000e-1 s")),
+        "the initialization names the horizon"
+    );
+    assert!(said_period.is_some_and(|m| m.contains("over one period of the lowest mode")));
+    assert!(run_error <= accuracy, "over the run: {run_error:.3e}");
+    assert!(
+        run_error < period_error,
+        "the run's horizon is the more accurate"
+    );
+    assert!(
+        run_steps > period_steps,
+        "the longer horizon asks for finer steps: {run_steps} against {period_steps}"
+    );
+}
+
+/// A step the iteration's floor passed is named (docs/formulation.md, "Time error control": the
+/// iteration's tolerance): the beam at `model.accuracy = 1e-3` in a run whose stop time is 2 s,
+/// of which 0.1 s are stepped. Over 2 s the allowance of a step is `ε D h / 2 s`, below the
+/// floor `10 × solver.tolerance × size` once the steps are fine: the body warns once, after the
+/// first period (while the deformation scale still grows from 0 the floor is what it needs),
+/// naming the tolerance that would let the control go on; with that tolerance the same run is
+/// closer to the fine reference.
+#[test]
+fn a_step_passed_by_the_iterations_floor_is_named() {
+    let end = 0.1;
+    let run = |settings: &[(&str, f64)]| {
+        let mut s = Slave::from_body(body()).unwrap();
+        s.setup_experiment(0.0, Some(2.0), None).unwrap();
+        s.enter_initialization_mode().unwrap();
+        s.set_by_name("solver.stepSize", H).unwrap();
+        for &(name, value) in settings {
+            s.set_by_name(name, value).unwrap();
+        }
+        s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
+        s.exit_initialization_mode().unwrap();
+        let tip = vr(&s, "tip.position[2]");
+        let y0 = s.get_real(tip).unwrap();
+        let mut warnings = Vec::new();
+        let mut history = Vec::new();
+        for k in 0..(end / H).round() as usize {
+            s.do_step(k as f64 * H, H).unwrap();
+            history.push(s.get_real(tip).unwrap() - y0);
+            warnings.extend(
+                s.drain_events()
+                    .filter(|e| e.message.contains("accepted on the iteration's floor"))
+                    .map(|e| e.message),
+            );
+        }
+        (history, warnings)
+    };
+    let (reference, _) = run(&[("model.accuracy", 0.0), ("solver.stepSize", 5e-6)]);
+    let peak = peak(&reference);
+    let (floored, warnings) = run(&[("model.accuracy", 1e-3)]);
+    println!("{warnings:?}");
+    assert_eq!(warnings.len(), 1, "warned once");
+    let suggested: f64 = warnings[0]
+        .rsplit("solver.tolerance = ")
+        .next()
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .expect("the warning names a tolerance");
+    assert!(suggested < 1e-10, "{suggested}");
+    let (tighter, _) = run(&[("model.accuracy", 1e-3), ("solver.tolerance", suggested)]);
+    let (floored_error, tighter_error) = (
+        largest_difference(&floored, &reference) / peak,
+        largest_difference(&tighter, &reference) / peak,
+    );
+    println!("at the default tolerance {floored_error:.3e} of the peak, at {suggested:e} {tighter_error:.3e}");
+    assert!(tighter_error < floored_error);
 }

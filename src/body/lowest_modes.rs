@@ -16,10 +16,10 @@
 //! * The **elastic displacement** relative to the supports, from the local deformation `ū` and
 //!   `g = K ū` ([`LowestModes::deformation`]).
 //! * The **errors that last**: a local error in mode `j` persists while the mode's damping
-//!   `σ_j = (α + β ω_j²)/2` (1/s, Rayleigh's `α`, `β`) lets it, about `1/σ_j`; over the period
-//!   `T₁` the errors of a step add up with the weight `w_j = min(1, 1/(σ_j T₁))`
-//!   ([`LowestModes::lasting_error`]). The modes above the kept ones get the weight of the
-//!   lowest of them, `ω_top` (they decay at least as fast).
+//!   `σ_j = (α + β ω_j²)/2` (1/s, Rayleigh's `α`, `β`) lets it, about `1/σ_j`; over the horizon
+//!   `H` (the run, or the period `T₁`) the errors of a step add up with the weight
+//!   `w_j = min(1, 1/(σ_j H))` ([`LowestModes::lasting_error`]). The modes above the kept ones
+//!   get the weight of the lowest of them, `ω_top` (they decay at least as fast).
 
 use super::frame::node;
 use crate::fem::modal::EigenPairs;
@@ -45,8 +45,8 @@ pub struct LowestModes {
     /// `ω_top²` (1/s²): the lowest eigenvalue above the kept ones (the highest kept if none was
     /// computed).
     omega_top_sq: f64,
-    /// `w_j = min(1, 1/(σ_j T₁))` of the kept modes, then of `ω_top`.
-    weights: [f64; MODES + 1],
+    /// `σ_j = (α + β ω_j²)/2` (1/s) of the kept modes, then of `ω_top`.
+    decay_rates: [f64; MODES + 1],
     /// The body's mass `m` (kg).
     total_mass: f64,
 }
@@ -86,13 +86,11 @@ impl LowestModes {
             omega_sq.push(w2);
         }
         let omega_top_sq = omega_top_sq.unwrap_or(*omega_sq.last().unwrap_or(&f64::INFINITY));
-        let period =
-            2.0 * std::f64::consts::PI / omega_sq.first().copied().unwrap_or(f64::INFINITY).sqrt();
         let (alpha, beta) = damping;
-        let weight = |w2: f64| (1.0 / ((alpha + beta * w2) / 2.0 * period)).min(1.0);
-        let mut weights = [weight(omega_top_sq); MODES + 1];
-        for (w, &w2) in weights.iter_mut().zip(&omega_sq) {
-            *w = weight(w2);
+        let decay_rate = |w2: f64| (alpha + beta * w2) / 2.0;
+        let mut decay_rates = [decay_rate(omega_top_sq); MODES + 1];
+        for (sigma, &w2) in decay_rates.iter_mut().zip(&omega_sq) {
+            *sigma = decay_rate(w2);
         }
         LowestModes {
             nodes: nodes.to_vec(),
@@ -100,7 +98,7 @@ impl LowestModes {
             mass_modes,
             omega_sq,
             omega_top_sq,
-            weights,
+            decay_rates,
             total_mass,
         }
     }
@@ -135,22 +133,30 @@ impl LowestModes {
         (squared / self.total_mass).sqrt()
     }
 
-    /// The errors that last, of a step whose local error is the field `d` (flat `3N`, global,
-    /// m) with the filtered estimate `error` (m, mass-weighted RMS): the weighted RMS of `d`'s
-    /// part in the lowest modes, `√(Σ_j (w_j p_j)² / m)`, and of the rest, `w_top √(error² −
-    /// Σ_j p_j² / m)` (m). No allocation.
-    pub fn lasting_error(&self, rotation: &Matrix3<f64>, d: &[f64], error: f64) -> (f64, f64) {
+    /// The errors that last over the horizon `horizon` `H` (s), of a step whose local error is
+    /// the field `d` (flat `3N`, global, m) with the filtered estimate `error` (m, mass-weighted
+    /// RMS): the weighted RMS of `d`'s part in the lowest modes, `√(Σ_j (w_j p_j)² / m)`, and
+    /// of the rest, `w_top √(error² − Σ_j p_j² / m)` (m), with `w_j = min(1, 1/(σ_j H))`. No
+    /// allocation.
+    pub fn lasting_error(
+        &self,
+        rotation: &Matrix3<f64>,
+        d: &[f64],
+        error: f64,
+        horizon: f64,
+    ) -> (f64, f64) {
+        let weight = |sigma: f64| (1.0 / (sigma * horizon)).min(1.0);
         let p = self.project(&self.mass_modes, rotation, d);
         let (mut plain, mut weighted) = (0.0, 0.0);
-        for (p, w) in p.iter().zip(&self.weights) {
+        for (p, &sigma) in p.iter().zip(&self.decay_rates) {
             plain += p * p;
-            weighted += (w * p).powi(2);
+            weighted += (weight(sigma) * p).powi(2);
         }
         let plain = (plain / self.total_mass).sqrt().min(error);
         let rest = (error * error - plain * plain).max(0.0).sqrt();
         (
             (weighted / self.total_mass).sqrt(),
-            self.weights[MODES] * rest,
+            weight(self.decay_rates[MODES]) * rest,
         )
     }
 
@@ -224,13 +230,19 @@ mod tests {
         // which gets the weight of ω_top² = 4.
         let d = [3.0, 0.0, 0.0, 4.0, 0.0, 0.0];
         let error = (12.5_f64 + 1.0).sqrt();
-        let (low, high) = modes.lasting_error(&Matrix3::identity(), &d, error);
+        let (low, high) = modes.lasting_error(&Matrix3::identity(), &d, error, period);
         let expected = (((w1 * 3.0).powi(2) + (w2 * 4.0).powi(2)) / 2.0).sqrt();
         assert!((low - expected).abs() < 1e-14, "{low} against {expected}");
         assert!((high - w2).abs() < 1e-12, "{high} against {w2}");
-        // Undamped, every error lasts the whole period.
+        // Over a horizon four times as long the damped errors weigh a quarter as much relative
+        // to it (they last 1/σ_j whatever the horizon); the weight never exceeds 1.
+        let (low4, high4) = modes.lasting_error(&Matrix3::identity(), &d, error, 4.0 * period);
+        assert!((low4 - expected / 4.0).abs() < 1e-14 && (high4 - w2 / 4.0).abs() < 1e-12);
+        let (short, _) = modes.lasting_error(&Matrix3::identity(), &d, error, 0.1);
+        assert!((short - 12.5_f64.sqrt()).abs() < 1e-14);
+        // Undamped, every error lasts the whole horizon.
         let (low, high) =
-            two_oscillators((0.0, 0.0)).lasting_error(&Matrix3::identity(), &d, error);
+            two_oscillators((0.0, 0.0)).lasting_error(&Matrix3::identity(), &d, error, period);
         assert!((low - 12.5_f64.sqrt()).abs() < 1e-14 && (high - 1.0).abs() < 1e-12);
     }
 

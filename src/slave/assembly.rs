@@ -532,16 +532,6 @@ impl Slave {
                 schemes::lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta))
             })
             .transpose()?;
-        if let Some(t1) = lowest_modes.as_ref().map(LowestModes::first_period) {
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message: format!(
-                    "model.accuracy = {:e}: the internal step is chosen from solver.stepSize / 2^k (k ≤ {}) so that the estimated error over one period of the lowest mode, T₁ = {t1:.4e} s, stays below model.accuracy × the deformation scale",
-                    p.accuracy,
-                    super::step_control::MAX_LEVEL
-                ),
-            });
-        }
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {

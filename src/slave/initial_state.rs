@@ -5,9 +5,9 @@ use super::assembly::Features;
 use super::auto_features::NOT_QUIET;
 use super::interfaces::{apply_loads, prescribe_motion, rotation_input};
 use super::step_control::Ladder;
-use super::{Dynamics, Slave};
+use super::{Dynamics, LogEvent, Slave};
 use crate::error::{Error, Result};
-use crate::model::InterfaceKind;
+use crate::model::{category, InterfaceKind};
 use crate::solver::generalized_alpha;
 use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
@@ -131,6 +131,24 @@ impl Slave {
             high_mode_scale: 0.0,
             estimate_floor: 0.0,
         });
+        if let Some(horizon) = self.error_horizon() {
+            let over = match self.stop_time {
+                Some(stop) if stop > self.start_time => format!(
+                    "over the run, stopTime − startTime = {horizon:.4e} s"
+                ),
+                _ => format!(
+                    "over one period of the lowest mode, T₁ = {horizon:.4e} s (the stop time is not defined: the errors of a longer run may add up to more)"
+                ),
+            };
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "model.accuracy = {:e}: the internal step is chosen from solver.stepSize / 2^k (k ≤ {}) so that the estimated errors that last {over} add up to at most model.accuracy × the deformation scale",
+                    self.parameters.accuracy,
+                    super::step_control::MAX_LEVEL
+                ),
+            });
+        }
         self.outputs.valid = false;
         Ok(())
     }

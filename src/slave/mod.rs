@@ -104,6 +104,7 @@ pub struct SlaveState {
     driving: Vec<DrivingFrame>,
     last_step_size: f64,
     start_time: f64,
+    stop_time: Option<f64>,
     dynamics: Option<Dynamics>,
     /// Internal steps, fixed-point iterations, retried internal steps, rejected communication
     /// steps.
@@ -161,6 +162,9 @@ pub struct Slave {
     /// `driving` before the current step, put back if the step is rolled back.
     driving_before: Vec<DrivingFrame>,
     start_time: f64,
+    /// `fmi2SetupExperiment`'s stop time, when defined: the run over which the time error
+    /// control's errors add up (docs/formulation.md, "Time error control": the horizon).
+    stop_time: Option<f64>,
     model: Option<Model>,
     dynamics: Option<Dynamics>,
     /// Backup of the dynamics at the start of a communication step (rollback on failure).
@@ -179,6 +183,9 @@ pub struct Slave {
     /// jump, `step_control::UNESTIMATED_WARN_AFTER`): in all, in a row, and whether the body
     /// has warned of them.
     unestimated: (u64, u32, bool),
+    /// Whether the body has warned that a step was accepted on the iteration's floor rather than
+    /// on `model.accuracy` (`slave::stepping::internal_steps`).
+    floor_warned: bool,
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
@@ -271,6 +278,7 @@ impl Slave {
             driving: vec![DrivingFrame::default(); n_interfaces],
             driving_before: vec![DrivingFrame::default(); n_interfaces],
             start_time: 0.0,
+            stop_time: None,
             model: None,
             dynamics: None,
             backup: None,
@@ -283,6 +291,7 @@ impl Slave {
             retries: 0,
             rejected: 0,
             unestimated: (0, 0, false),
+            floor_warned: false,
             step_error: None,
             step_estimate: 0.0,
             inputs_jumped: false,
@@ -317,7 +326,9 @@ impl Slave {
         &self.parameters
     }
 
-    /// `fmi2SetupExperiment`: start time; stop time and tolerance are optional (and not needed).
+    /// `fmi2SetupExperiment`: start time; the stop time, when defined, is the end of the run over
+    /// which `model.accuracy` holds (docs/formulation.md, "Time error control": the horizon);
+    /// the tolerance is not needed (`solver.tolerance` governs the iteration).
     pub fn setup_experiment(
         &mut self,
         start_time: f64,
@@ -342,6 +353,8 @@ impl Slave {
         }
         let _ = tolerance; // the body's own solver.tolerance governs the iteration
         self.start_time = start_time;
+        // An infinite stop time is a run without end: no horizon.
+        self.stop_time = stop_time.filter(|stop| stop.is_finite());
         // Inputs set before the experiment is set up describe the start.
         self.input_times.fill(start_time);
         Ok(())
@@ -479,6 +492,7 @@ impl Slave {
             *d = [[0.0; INTERFACE_SLOTS]; 2];
         }
         self.start_time = 0.0;
+        self.stop_time = None;
         self.input_times.fill(0.0);
         self.driving.fill(DrivingFrame::default());
         self.last_step_size = 0.0;
@@ -489,6 +503,7 @@ impl Slave {
         self.retries = 0;
         self.rejected = 0;
         self.unestimated = (0, 0, false);
+        self.floor_warned = false;
         self.outputs.valid = false;
         self.results = None;
     }
@@ -503,6 +518,7 @@ impl Slave {
             driving: self.driving.clone(),
             last_step_size: self.last_step_size,
             start_time: self.start_time,
+            stop_time: self.stop_time,
             dynamics: self.dynamics.clone(),
             counters: [
                 self.statistics.0,
@@ -530,6 +546,7 @@ impl Slave {
         self.last_step_size = state.last_step_size;
         self.jacobian_step = None;
         self.start_time = state.start_time;
+        self.stop_time = state.stop_time;
         self.statistics = (state.counters[0], state.counters[1]);
         self.retries = state.counters[2];
         self.rejected = state.counters[3];

@@ -14,6 +14,7 @@
 //! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3]) f64: each motion interface's frame at the start of the last step (zeros and the identity for other interfaces) |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
+//! | stop time | u8 (1: defined), f64 (0 when not) |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
 //! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the last internal step's length f64 (0: none) |
@@ -32,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 9;
+pub const PAYLOAD_FORMAT: u32 = 10;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -205,6 +206,8 @@ impl SlaveState {
         }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
+        w.u8(u8::from(self.stop_time.is_some()));
+        w.f64(self.stop_time.unwrap_or(0.0));
         self.counters.iter().for_each(|&c| w.u64(c));
         match &self.dynamics {
             None => w.u8(0),
@@ -281,6 +284,14 @@ impl Slave {
         }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;
+        let stop_defined = r.boolean("whether the stop time is defined")?;
+        let stop_time = r.f64("the stop time")?;
+        let stop_time = stop_defined.then_some(stop_time);
+        if let Some(stop) = stop_time.filter(|&stop| stop < start_time) {
+            return Err(Error::new(format!(
+                "the serialized FMU state's stop time {stop} is before its start time {start_time}"
+            )));
+        }
         let counters = [
             r.u64("the step counter")?,
             r.u64("the iteration counter")?,
@@ -303,6 +314,7 @@ impl Slave {
             driving,
             last_step_size,
             start_time,
+            stop_time,
             dynamics,
             counters,
         })

@@ -5,15 +5,18 @@
 //! `generalized_alpha::IterationMatrix::local_error`). The step is accepted when
 //!
 //! ```text
-//! e ≤ allowance(h) = max(ε D h / T₁,  ITERATION_NOISE × solver.tolerance × size)
+//! e ≤ allowance(h) = max(ε D h / H,  ITERATION_NOISE × tolerance × size)
 //! ```
 //!
 //! with `ε = model.accuracy`, `D` the deformation scale (the largest mass-weighted RMS elastic
 //! displacement relative to the supports seen so far, from the lowest modes, or quasi-static
-//! displacement of the accelerations, m: docs/formulation.md, "The deformation scale") and
-//! `T₁ = 2π/ω₁` the period of the body's lowest natural frequency: the errors committed over one period of the lowest mode add up to at most
-//! `ε D`. The floor is above the iteration's own error: the estimate differences accelerations
-//! of converged iterates, each off by up to `solver.tolerance × size` in position, which puts a
+//! displacement of the accelerations, m: docs/formulation.md, "The deformation scale") and `H`
+//! the horizon (s): the run, `stopTime − startTime`, when the importer defined its stop time,
+//! else the period `T₁ = 2π/ω₁` of the body's lowest natural frequency (docs/formulation.md,
+//! "The horizon"): the errors committed over the horizon add up to at most `ε D`. The floor is
+//! above the iteration's own error: the estimate differences accelerations of converged
+//! iterates, each off by up to the iteration's `tolerance × size` in position
+//! (`Parameters::iteration_tolerance`), which puts a
 //! noise of `(β − 1/6)/β` of that into `e` whatever `h` is; asking the time step for less would
 //! refine it down the whole ladder for nothing.
 //!
@@ -209,17 +212,17 @@ pub fn finer_level(level: u32, ratio: f64) -> u32 {
     (level + rungs.min(MAX_LEVEL as f64) as u32).min(MAX_LEVEL)
 }
 
-/// The allowance of an internal step `h` (m): `max(ε D h / T₁, floor)`.
-pub fn allowance(accuracy: f64, scale: f64, h: f64, period: f64, floor: f64) -> f64 {
-    (accuracy * scale * h / period).max(floor)
+/// The allowance of an internal step `h` (m): `max(ε D h / H, floor)`, `H` the horizon (s).
+pub fn allowance(accuracy: f64, scale: f64, h: f64, horizon: f64, floor: f64) -> f64 {
+    (accuracy * scale * h / horizon).max(floor)
 }
 
 /// The error of an internal step against what it may commit (docs/formulation.md, "Time error
 /// control": the errors that last). The step's estimate is split into `low` (m), its part in
-/// the lowest modes, and `high` (m), the rest, each weighted by the share of `T₁` its errors
-/// persist ([`crate::body::lowest_modes::LowestModes::lasting_error`]). The accumulated error of
+/// the lowest modes, and `high` (m), the rest, each weighted by the share of the horizon `H` its
+/// errors persist ([`crate::body::lowest_modes::LowestModes::lasting_error`]). The accumulated error of
 /// a mode cannot exceed twice its amplitude, and the modes above the lowest have at most the
-/// amplitude `high_amplitude` `A` (m). With the budget `ε D` (m) and `allowance = ε D h / T₁`:
+/// amplitude `high_amplitude` `A` (m). With the budget `ε D` (m) and `allowance = ε D h / H`:
 ///
 /// * if `2A ≤ ε D / √2`, no step size can make the high modes exceed `2A`: they are not
 ///   controlled, and the low modes get the rest of the budget in quadrature,

@@ -327,6 +327,16 @@ impl Slave {
         dynamics.deformation_scale = dynamics.deformation_scale.max(quasi_static);
     }
 
+    /// The horizon `H` (s) over which the time error control lets the errors of its steps add
+    /// up to `model.accuracy × D` (docs/formulation.md, "Time error control": the horizon): the
+    /// run, `stopTime − startTime`, when the importer defined its stop time, else the period
+    /// `T₁` of the lowest mode. `None` without error control.
+    pub(in crate::slave) fn error_horizon(&self) -> Option<f64> {
+        let period = self.model.as_ref()?.lowest_modes.as_ref()?.first_period();
+        let run = self.stop_time.map(|stop| stop - self.start_time);
+        Some(run.filter(|&run| run > 0.0).unwrap_or(period))
+    }
+
     /// Whether the internal step is chosen by the error estimate (`model.accuracy > 0` with
     /// generalized-α, the scheme that estimates its error).
     fn error_controlled(&self) -> bool {

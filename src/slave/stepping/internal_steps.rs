@@ -88,7 +88,7 @@ impl Slave {
         m: usize,
         last_of_step: bool,
     ) -> Result<()> {
-        let floor = self.parameters.tolerance * self.size;
+        let floor = self.parameters.iteration_tolerance() * self.size;
         let mut settings = IterationSettings {
             absolute_tolerance: floor,
             max_iterations: self.parameters.max_iterations.max(1) as usize,
@@ -98,15 +98,11 @@ impl Slave {
         let jumped = self.inputs_jumped;
         // The allowance of these internal steps, from the deformation scale (updated after
         // each step that is estimated, and at the end of each communication step).
-        let period = self
-            .model
-            .as_ref()
-            .and_then(|m| m.lowest_modes.as_ref())
-            .map(LowestModes::first_period);
+        let horizon = self.error_horizon();
         let accuracy = self.parameters.accuracy;
         let noise = (ITERATION_NOISE * floor).max(self.dynamics.as_ref().unwrap().estimate_floor);
-        let allowed = |scale: f64| match (controlled, period) {
-            (true, Some(period)) => allowance(accuracy, scale, hs, period, noise),
+        let allowed = |scale: f64| match (controlled, horizon) {
+            (true, Some(horizon)) => allowance(accuracy, scale, hs, horizon, noise),
             _ => f64::INFINITY,
         };
         let model = self.model.as_mut().expect("the model exists during a step");
@@ -197,21 +193,47 @@ impl Slave {
                     .integrator
                     .local_error_field()
                     .expect("generalized-α estimated");
-                let (low, high) = modes.lasting_error(&rotation, d, e);
+                let horizon = horizon.expect("controlled");
+                let (low, high) = modes.lasting_error(&rotation, d, e, horizon);
                 let ratio = error_ratio(
                     low,
                     high,
                     dynamics.high_mode_scale,
                     accuracy * dynamics.deformation_scale,
-                    allowance(
-                        accuracy,
-                        dynamics.deformation_scale,
-                        hs,
-                        period.expect("controlled"),
-                        0.0,
-                    ),
+                    allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
                     noise,
                 );
+                let judged_on_floor = ratio <= 1.0
+                    && error_ratio(
+                        low,
+                        high,
+                        dynamics.high_mode_scale,
+                        accuracy * dynamics.deformation_scale,
+                        allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
+                        0.0,
+                    ) > 1.0;
+                // The iteration's tolerance, not the accuracy, passed this step
+                // (docs/formulation.md, "Time error control": the iteration's tolerance). In
+                // the first period the deformation scale is still building up from 0, and a
+                // floor there is the one it needs.
+                if judged_on_floor
+                    && !self.floor_warned
+                    && dynamics.estimate_floor < ITERATION_NOISE * floor
+                    && dynamics.state.time - self.start_time > modes.first_period()
+                {
+                    self.floor_warned = true;
+                    let allowed = allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0);
+                    self.events.push(LogEvent {
+                        category: category::EVENTS,
+                        message: format!(
+                            "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {allowed:.3e} m: below the iteration's tolerance ({:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on",
+                            dynamics.state.time,
+                            ITERATION_NOISE * floor,
+                            floor / self.size,
+                            allowed / (2.0 * ITERATION_NOISE * self.size),
+                        ),
+                    });
+                }
                 self.step_estimate = self.step_estimate.max(e);
                 self.step_error = Some(self.step_error.unwrap_or(0.0).max(ratio));
             }
