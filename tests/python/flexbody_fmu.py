@@ -99,9 +99,10 @@ class Instance:
         """Messages this instance logged (optionally only those with `status`)."""
         return [r for r in LOG if r.instance_name == self.name and (status is None or r.status == status)]
 
-    def initialize(self, start_values=None, start_time=0.0):
-        """setupExperiment, start values (in Initialization Mode), exitInitializationMode."""
-        self.fmu.setupExperiment(startTime=start_time)
+    def initialize(self, start_values=None, start_time=0.0, stop_time=None):
+        """setupExperiment (the stop time, when given, is the run over which model.accuracy
+        holds), start values (in Initialization Mode), exitInitializationMode."""
+        self.fmu.setupExperiment(startTime=start_time, stopTime=stop_time)
         self.fmu.enterInitializationMode()
         for name, value in (start_values or {}).items():
             self.set(name, value)
