@@ -189,6 +189,9 @@ pub struct Slave {
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
+    /// The largest ratio of the communication step under way against the accuracy alone, the
+    /// iteration's floor left out: how far a rejected step must be refined.
+    step_error_unfloored: f64,
     /// The largest local error estimate of the current communication step's attempt (m).
     step_estimate: f64,
     /// Whether an input jumped at the start of the communication step under way.
@@ -293,6 +296,7 @@ impl Slave {
             unestimated: (0, 0, false),
             floor_warned: false,
             step_error: None,
+            step_error_unfloored: 0.0,
             step_estimate: 0.0,
             inputs_jumped: false,
             scale_scratch: Vec::new(),

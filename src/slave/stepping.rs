@@ -97,6 +97,7 @@ impl Slave {
                 self.load_scale();
             }
             self.step_error = None;
+            self.step_error_unfloored = 0.0;
             self.step_estimate = 0.0;
             let mut result = Ok(());
             for i in 0..n {
@@ -208,10 +209,14 @@ impl Slave {
             if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
                 // control"); a probe on the rung it came from.
+                // As far down as the accuracy asks: a step rejected on the iteration's floor
+                // has an estimate above that floor, which is error of the time step, and the
+                // allowance below the floor is what it must meet (docs/formulation.md, "Time
+                // error control": the iteration's tolerance).
                 let finer = if probing {
                     ladder.level
                 } else {
-                    finer_level(level, ratio)
+                    finer_level(level, ratio.max(self.step_error_unfloored))
                 };
                 self.rejected += 1;
                 self.events.push(LogEvent {

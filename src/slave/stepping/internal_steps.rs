@@ -203,15 +203,16 @@ impl Slave {
                     allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
                     noise,
                 );
-                let judged_on_floor = ratio <= 1.0
-                    && error_ratio(
-                        low,
-                        high,
-                        dynamics.high_mode_scale,
-                        accuracy * dynamics.deformation_scale,
-                        allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
-                        0.0,
-                    ) > 1.0;
+                let unfloored = error_ratio(
+                    low,
+                    high,
+                    dynamics.high_mode_scale,
+                    accuracy * dynamics.deformation_scale,
+                    allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
+                    dynamics.estimate_floor,
+                );
+                self.step_error_unfloored = self.step_error_unfloored.max(unfloored);
+                let judged_on_floor = ratio <= 1.0 && unfloored > 1.0;
                 // The iteration's tolerance, not the accuracy, passed this step
                 // (docs/formulation.md, "Time error control": the iteration's tolerance). In
                 // the first period the deformation scale is still building up from 0, and a
