@@ -23,8 +23,13 @@ fn vr(s: &Slave, name: &str) -> u32 {
 
 /// A slave of `body` with `settings` (by name), the 10 N tip load set, initialized.
 fn slave(body: BodyFile, settings: &[(&str, f64)]) -> Slave {
+    slave_until(body, settings, None)
+}
+
+/// [`slave`] for a run whose stop time is `stop` (the horizon of the error control).
+fn slave_until(body: BodyFile, settings: &[(&str, f64)], stop: Option<f64>) -> Slave {
     let mut s = Slave::from_body(body).unwrap();
-    s.setup_experiment(0.0, None, None).unwrap();
+    s.setup_experiment(0.0, stop, None).unwrap();
     s.enter_initialization_mode().unwrap();
     s.set_by_name("solver.stepSize", H).unwrap();
     for &(name, value) in settings {
@@ -440,15 +445,7 @@ fn a_discarded_step_changes_nothing_that_follows() {
 fn the_errors_add_up_over_the_run_when_its_stop_time_is_known() {
     let end = 0.5;
     let run = |stop: Option<f64>, settings: &[(&str, f64)]| {
-        let mut s = Slave::from_body(body()).unwrap();
-        s.setup_experiment(0.0, stop, None).unwrap();
-        s.enter_initialization_mode().unwrap();
-        s.set_by_name("solver.stepSize", H).unwrap();
-        for &(name, value) in settings {
-            s.set_by_name(name, value).unwrap();
-        }
-        s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
-        s.exit_initialization_mode().unwrap();
+        let mut s = slave_until(body(), settings, stop);
         let horizon = s
             .drain_events()
             .find(|e| e.message.contains("errors that last"))
@@ -496,15 +493,7 @@ fn the_errors_add_up_over_the_run_when_its_stop_time_is_known() {
 fn a_step_passed_by_the_iterations_floor_is_named() {
     let end = 0.1;
     let run = |settings: &[(&str, f64)]| {
-        let mut s = Slave::from_body(body()).unwrap();
-        s.setup_experiment(0.0, Some(2.0), None).unwrap();
-        s.enter_initialization_mode().unwrap();
-        s.set_by_name("solver.stepSize", H).unwrap();
-        for &(name, value) in settings {
-            s.set_by_name(name, value).unwrap();
-        }
-        s.set_real(vr(&s, "tip.force[2]"), -10.0).unwrap();
-        s.exit_initialization_mode().unwrap();
+        let mut s = slave_until(body(), settings, Some(2.0));
         let tip = vr(&s, "tip.position[2]");
         let y0 = s.get_real(tip).unwrap();
         let mut warnings = Vec::new();

@@ -195,22 +195,20 @@ impl Slave {
                     .expect("generalized-α estimated");
                 let horizon = horizon.expect("controlled");
                 let (low, high) = modes.lasting_error(&rotation, d, e, horizon);
-                let ratio = error_ratio(
-                    low,
-                    high,
-                    dynamics.high_mode_scale,
-                    accuracy * dynamics.deformation_scale,
-                    allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
-                    noise,
-                );
-                let unfloored = error_ratio(
-                    low,
-                    high,
-                    dynamics.high_mode_scale,
-                    accuracy * dynamics.deformation_scale,
-                    allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
-                    dynamics.estimate_floor,
-                );
+                // The ratio above `floor` (m): with the iteration's, and without it (the
+                // accuracy alone, with the learnt estimate floor).
+                let ratio_above = |floor: f64| {
+                    error_ratio(
+                        low,
+                        high,
+                        dynamics.high_mode_scale,
+                        accuracy * dynamics.deformation_scale,
+                        allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
+                        floor,
+                    )
+                };
+                let ratio = ratio_above(noise);
+                let unfloored = ratio_above(dynamics.estimate_floor);
                 self.step_error_unfloored = self.step_error_unfloored.max(unfloored);
                 let judged_on_floor = ratio <= 1.0 && unfloored > 1.0;
                 // The iteration's tolerance, not the accuracy, passed this step
