@@ -208,11 +208,10 @@ impl Slave {
             }
             if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
-                // control"); a probe on the rung it came from.
-                // As far down as the accuracy asks: a step rejected on the iteration's floor
-                // has an estimate above that floor, which is error of the time step, and the
-                // allowance below the floor is what it must meet (docs/formulation.md, "Time
-                // error control": the iteration's tolerance).
+                // control"), a probe on the rung it came from; as far down as the accuracy asks:
+                // a step rejected on the iteration's floor has an estimate above that floor,
+                // error of the time step, and must meet the allowance below it
+                // (docs/formulation.md, "The iteration's tolerance").
                 let finer = if probing {
                     ladder.level
                 } else {
