@@ -224,6 +224,19 @@ impl FrameWeights {
         }
         -(h_inv * b)
     }
+
+    /// The best-fit frame of positions `x` and its body-frame angular velocity `ω̄` (rad/s) at
+    /// velocities `v` ([`Self::best_fit`], [`Self::angular_velocity`]; `H⁻¹` taken as zero where
+    /// `H` is singular). O(N), no allocation.
+    pub fn moving_frame(&self, x: &[f64], v: &[f64]) -> (Frame, Vector3<f64>) {
+        let frame = self.best_fit(x);
+        let h_inv = self
+            .rotation_sensitivity(&frame, x)
+            .try_inverse()
+            .unwrap_or_else(Matrix3::zeros);
+        let omega = self.angular_velocity(&frame, &h_inv, v);
+        (frame, omega)
+    }
 }
 
 #[cfg(test)]

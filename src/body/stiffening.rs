@@ -40,13 +40,8 @@ pub enum GeometricStiffening {
 /// `inertial` stiffening's `K_G = Σ_k c_k K_G,k`. O(N), no allocation.
 pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f64; 12] {
     let fw = &body.frame_weights;
-    let frame = fw.best_fit(x);
+    let (frame, omega) = fw.moving_frame(x, v);
     let rt = frame.rotation.transpose();
-    let h_inv = fw
-        .rotation_sensitivity(&frame, x)
-        .try_inverse()
-        .unwrap_or_else(Matrix3::zeros);
-    let omega = fw.angular_velocity(&frame, &h_inv, v);
     let c_ddot = rt * fw.centroid(a);
     let mut j = Matrix3::zeros();
     let mut b = Vector3::zeros();

@@ -132,11 +132,9 @@ impl Slave {
             estimate_floor: 0.0,
         });
         if let Some(horizon) = self.error_horizon() {
-            let over = match self.stop_time {
-                Some(stop) if stop > self.start_time => format!(
-                    "over the run, stopTime − startTime = {horizon:.4e} s"
-                ),
-                _ => format!(
+            let over = match self.run_length() {
+                Some(_) => format!("over the run, stopTime − startTime = {horizon:.4e} s"),
+                None => format!(
                     "over one period of the lowest mode, T₁ = {horizon:.4e} s (the stop time is not defined: the errors of a longer run may add up to more)"
                 ),
             };

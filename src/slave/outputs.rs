@@ -182,13 +182,9 @@ fn body_outputs(body: &Body, state: &DynamicState, kin: &BodyKinematics, outputs
     // The body's best-fit frame and its angular velocity, also where a linear body holds its
     // frame at the placement (docs/formulation.md, "The linear body").
     let (r, omega_body) = if body.linear.is_some() {
-        let fw = &body.frame_weights;
-        let frame = fw.best_fit(&state.position);
-        let h_inv = fw
-            .rotation_sensitivity(&frame, &state.position)
-            .try_inverse()
-            .unwrap_or_else(nalgebra::Matrix3::zeros);
-        let omega = fw.angular_velocity(&frame, &h_inv, &state.velocity);
+        let (frame, omega) = body
+            .frame_weights
+            .moving_frame(&state.position, &state.velocity);
         (frame.rotation, omega)
     } else {
         (kin.frame.rotation, kin.angular_velocity_body)

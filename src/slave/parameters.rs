@@ -11,9 +11,10 @@ use crate::model::{BodyFile, Target};
 use crate::solver::anderson::MAX_DEPTH;
 
 /// The iteration's tolerance per unit of `model.accuracy` ([`Parameters::iteration_tolerance`]):
-/// the allowance's floor, `ITERATION_NOISE` (10) × the tolerance × size, then lies 1e-7 ε × size
-/// below the accuracy's error, which on B1 (size 1.4 m, deformation scale 5.7e-4 m) keeps it
-/// below the allowance down to `ε = 1e-4` (docs/formulation.md, "Time error control").
+/// 1e-10 at `ε` 1e-2 and 1e-3 (the default `solver.tolerance`, nothing changes there), 1e-11 at
+/// 1e-4, where the floor `ITERATION_NOISE × tolerance × size` of 1e-10 stopped B1's refinement at
+/// 1.5e-4 of the peak. `1e-8` trapped B3 stepped in half steps on 78 µs at `ε ≤ 5e-3`
+/// (docs/formulation.md, "Time error control": the iteration's tolerance).
 pub const TOLERANCE_PER_ACCURACY: f64 = 1e-7;
 
 /// The smallest iteration tolerance the accuracy sets: a few hundred ulps of the positions, above

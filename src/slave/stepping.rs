@@ -337,8 +337,14 @@ impl Slave {
     /// `T₁` of the lowest mode. `None` without error control.
     pub(in crate::slave) fn error_horizon(&self) -> Option<f64> {
         let period = self.model.as_ref()?.lowest_modes.as_ref()?.first_period();
+        Some(self.run_length().unwrap_or(period))
+    }
+
+    /// The run's length `stopTime − startTime` (s), when the importer defined a stop time after
+    /// the start.
+    pub(in crate::slave) fn run_length(&self) -> Option<f64> {
         let run = self.stop_time.map(|stop| stop - self.start_time);
-        Some(run.filter(|&run| run > 0.0).unwrap_or(period))
+        run.filter(|&run| run > 0.0)
     }
 
     /// Whether the internal step is chosen by the error estimate (`model.accuracy > 0` with

@@ -195,15 +195,17 @@ impl Slave {
                     .expect("generalized-α estimated");
                 let horizon = horizon.expect("controlled");
                 let (low, high) = modes.lasting_error(&rotation, d, e, horizon);
-                // The ratio above `floor` (m): with the iteration's, and without it (the
-                // accuracy alone, with the learnt estimate floor).
+                // What the accuracy alone allows this step (m), and the ratio above `floor` (m):
+                // with the iteration's, and without it (with the learnt estimate floor).
+                let accuracy_allows =
+                    allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0);
                 let ratio_above = |floor: f64| {
                     error_ratio(
                         low,
                         high,
                         dynamics.high_mode_scale,
                         accuracy * dynamics.deformation_scale,
-                        allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0),
+                        accuracy_allows,
                         floor,
                     )
                 };
@@ -221,15 +223,14 @@ impl Slave {
                     && dynamics.state.time - self.start_time > modes.first_period()
                 {
                     self.floor_warned = true;
-                    let allowed = allowance(accuracy, dynamics.deformation_scale, hs, horizon, 0.0);
                     self.events.push(LogEvent {
                         category: category::EVENTS,
                         message: format!(
-                            "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {allowed:.3e} m: below the iteration's tolerance ({:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on",
+                            "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {accuracy_allows:.3e} m: below the iteration's tolerance ({:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on",
                             dynamics.state.time,
                             ITERATION_NOISE * floor,
                             floor / self.size,
-                            allowed / (2.0 * ITERATION_NOISE * self.size),
+                            accuracy_allows / (2.0 * ITERATION_NOISE * self.size),
                         ),
                     });
                 }

@@ -5,7 +5,7 @@ use super::GeneralizedAlpha;
 use crate::body::frame::{nearest_rigid_field, node};
 use crate::body::Body;
 use crate::solver::problem::{DynamicState, FreeNodes};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// Carries a state made by steps of `h` (`state.step_size`) over to steps of `h'`
 /// (docs/formulation.md, "Generalized-α across a change of step"). On a smooth motion the
@@ -63,12 +63,8 @@ pub(super) fn rigid_jerk(
     if body.reduction.is_some() {
         // A reduced body's coordinates are fields' coefficients: the centroid and its
         // acceleration are the frame's linear sums, and `ω` the co-moving frame's.
-        let frame = weights.best_fit(&state.position);
-        let h_inv = weights
-            .rotation_sensitivity(&frame, &state.position)
-            .try_inverse()
-            .unwrap_or_else(Matrix3::zeros);
-        let omega = frame.rotation * weights.angular_velocity(&frame, &h_inv, &state.velocity);
+        let (frame, omega_body) = weights.moving_frame(&state.position, &state.velocity);
+        let omega = frame.rotation * omega_body;
         let acceleration = weights.centroid(&state.acceleration);
         return (omega.cross(&acceleration), omega, frame.origin);
     }
