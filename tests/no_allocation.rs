@@ -31,6 +31,7 @@ fn do_step_does_not_allocate_after_the_first_step() {
     // model.auto (the default) with both terms allowed: the indicators run every step.
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.stiffening", 2.0)]);
     pinned_radau_steps_do_not_allocate();
+    reduced_stiffened_steps_do_not_allocate();
     controlled_steps_do_not_allocate();
     step_jacobians_do_not_allocate_after_the_first(&[]);
     // Stiffening on (model.auto off): its K_G is copied into the Jacobian's workspace.
@@ -190,5 +191,33 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
     assert!(
         stats.allocations + stats.reallocations <= 2 * decisions,
         "allocations in 20 steps with {settings:?}: {stats:?}, {decisions} decisions logged"
+    );
+}
+
+/// A reduced body's inertial stiffening (B3: its prestress from the hub's driving motion) sums
+/// its unit cases into `K_G` in place.
+fn reduced_stiffened_steps_do_not_allocate() {
+    let mut s = initialized(
+        example_body("hub_beam"),
+        &[
+            ("model.modes", 4.0),
+            ("model.stiffening", 2.0),
+            ("model.accuracy", 0.0),
+        ],
+    );
+    let drive = common::b3::HubDrive::new(&s);
+    let h = 1e-2;
+    for k in 0..3 {
+        drive.step(&mut s, k as f64 * h, h).unwrap();
+    }
+    s.drain_events().for_each(drop);
+    let region = Region::new(GLOBAL);
+    for k in 3..23 {
+        drive.step(&mut s, k as f64 * h, h).unwrap();
+    }
+    let stats = region.change();
+    assert!(
+        stats.allocations + stats.reallocations == 0,
+        "allocations in 20 steps of the reduced B3 with stiffening: {stats:?}"
     );
 }

@@ -317,6 +317,37 @@ impl Reduction {
         }
     }
 
+    /// The Galerkin projection `(S ⊗ I3)ᵀ A (S ⊗ I3)` (`3s × 3s`, dense pattern) of a symmetric
+    /// mesh matrix `A` (`3N × 3N`): a geometric stiffness on the reduced coordinates
+    /// (docs/formulation.md, "The reduced body": geometric stiffening). Allocates; set-up only.
+    pub fn project_matrix(&self, a: &SymmetricCsr) -> SymmetricCsr {
+        let (s, n) = (self.field_count, self.node_count);
+        let mut projected = DMatrix::<f64>::zeros(3 * s, 3 * s);
+        let (mut u, mut au) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
+        for l in 0..s {
+            for b in 0..3 {
+                u.fill(0.0);
+                for i in 0..n {
+                    u[3 * i + b] = self.row(i)[l];
+                }
+                a.mul_vec(&u, &mut au);
+                let mut column = vec![0.0; 3 * s];
+                for i in 0..n {
+                    let ai = node(&au, i);
+                    for (k, &sik) in self.row(i).iter().enumerate() {
+                        for d in 0..3 {
+                            column[3 * k + d] += sik * ai[d];
+                        }
+                    }
+                }
+                for (r, v) in column.into_iter().enumerate() {
+                    projected[(r, 3 * l + b)] = v;
+                }
+            }
+        }
+        dense_symmetric(&(0.5 * (&projected + projected.transpose())))
+    }
+
     /// The expanded nodal vector `x_i = Σ_k S_ik q_k` (flat `3N`) of a reduced vector `q`
     /// (flat `3s`): positions, velocities or accelerations.
     pub fn expand(&self, q: &[f64]) -> Vec<f64> {

@@ -4,12 +4,15 @@
 //! * `inertial`: the static stress of the co-moving frame's rigid acceleration field
 //!   `a(X) = c̈ + α × X̄ + ω × (ω × X̄)` (body axes), linear in the 12 coefficients
 //!   `c̈` (3), `α` (3) and `ω_a ω_b` (6, a ≤ b): `K_G = Σ_k c_k K_G,k` with the 12 unit load cases
-//!   (body force `−ρ a_k`, clamped nodes held) precomputed once;
+//!   (body force `−ρ a_k`, clamped nodes held) precomputed once. On a reduced body the unit
+//!   cases are projected on its fields, `(S ⊗ I3)ᵀ K_G,k (S ⊗ I3)`, and the coefficients come
+//!   from the motion interface's driving motion, not from the state;
 //! * `stress`: the stress of the current local deformation, `S0 = D : sym ∇ū`, `K_G` reassembled.
 //!
 //! Either way `K_G` is refreshed once per communication step and held during it.
 
-use super::frame::{node, set_node};
+use super::frame::{node, set_node, Frame};
+use super::reduction::Reduction;
 use super::Body;
 use crate::error::{Error, Result};
 use crate::fem::geometric::{
@@ -25,8 +28,12 @@ use nalgebra::{Matrix3, Vector3};
 /// Which prestress drives the stiffening.
 #[derive(Debug, Clone)]
 pub enum GeometricStiffening {
-    /// The 12 unit load cases' geometric stiffnesses.
-    Inertial { unit_cases: Vec<SymmetricCsr> },
+    /// The 12 unit load cases' geometric stiffnesses and the largest magnitude of each one's
+    /// entries (N/m per unit coefficient).
+    Inertial {
+        unit_cases: Vec<SymmetricCsr>,
+        scales: Vec<f64>,
+    },
     /// Gauss-point stresses and the local deformation (scratch).
     Stress {
         stresses: Vec<[f64; 6]>,
@@ -53,6 +60,50 @@ pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f
     }
     let alpha = j.try_inverse().unwrap_or_else(Matrix3::zeros) * b;
     let w = omega;
+    [
+        c_ddot.x,
+        c_ddot.y,
+        c_ddot.z,
+        alpha.x,
+        alpha.y,
+        alpha.z,
+        w.x * w.x,
+        w.y * w.y,
+        w.z * w.z,
+        w.x * w.y,
+        w.x * w.z,
+        w.y * w.z,
+    ]
+}
+
+/// A term of `inertial`'s sum below this fraction of the largest, `|c_k| max|K_G,k|`, is below
+/// the sum's round-off and left out.
+const NEGLIGIBLE_TERM: f64 = 1e-14;
+
+/// The rigid motion a motion interface imposes (global axes): its point `p` (m), angular
+/// velocity `ω` (rad/s) and angular acceleration `α` (rad/s²), and the point's acceleration
+/// `a_p` (m/s²).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrivingAcceleration {
+    pub point: Vector3<f64>,
+    pub angular_velocity: Vector3<f64>,
+    pub angular_acceleration: Vector3<f64>,
+    pub acceleration: Vector3<f64>,
+}
+
+/// The 12 coefficients of the rigid acceleration field of a driving motion, in the axes of the
+/// body's co-moving `frame` (docs/formulation.md, "The reduced body": stiffening from the
+/// driving motion): the field's acceleration at the frame's origin `c`,
+/// `c̈ = Rᵀ (a_p + α × r + ω × (ω × r))` with `r = c − p`, then `Rᵀα` and `ω̄_a ω̄_b` with
+/// `ω̄ = Rᵀω`, in the order of [`inertial_coefficients`]. Unlike those, they do not see the
+/// body's own vibration, which through `f_stiff` would feed back on itself.
+pub fn driven_inertial_coefficients(frame: &Frame, driving: &DrivingAcceleration) -> [f64; 12] {
+    let rt = frame.rotation.transpose();
+    let (w, r) = (driving.angular_velocity, frame.origin - driving.point);
+    let c_ddot = rt
+        * (driving.acceleration + driving.angular_acceleration.cross(&r) + w.cross(&w.cross(&r)));
+    let alpha = rt * driving.angular_acceleration;
+    let w = rt * w;
     [
         c_ddot.x,
         c_ddot.y,
@@ -135,7 +186,40 @@ impl GeometricStiffening {
                 &stress_at_gauss_points(mesh, material, &u),
             ));
         }
-        Ok(GeometricStiffening::Inertial { unit_cases })
+        Ok(GeometricStiffening::inertial_of(unit_cases))
+    }
+
+    /// `inertial` stiffening of a reduced body: the mesh body's unit cases (`mesh_body`, held
+    /// at its `clamped` nodes) projected on the basis, `(S ⊗ I3)ᵀ K_G,k (S ⊗ I3)`
+    /// (docs/formulation.md, "The reduced body": geometric stiffening). The prestress is the
+    /// mesh's static response to each unit field, not the modes'.
+    pub fn inertial_reduced(
+        mesh: &Mesh,
+        material: &IsotropicMaterial,
+        mesh_body: &Body,
+        clamped: &[bool],
+        reduction: &Reduction,
+    ) -> Result<GeometricStiffening> {
+        let GeometricStiffening::Inertial { unit_cases, .. } =
+            GeometricStiffening::inertial(mesh, material, mesh_body, clamped)?
+        else {
+            unreachable!("inertial builds the unit cases")
+        };
+        Ok(GeometricStiffening::inertial_of(
+            unit_cases
+                .iter()
+                .map(|k| reduction.project_matrix(k))
+                .collect(),
+        ))
+    }
+
+    /// `inertial` stiffening of its 12 unit cases.
+    fn inertial_of(unit_cases: Vec<SymmetricCsr>) -> GeometricStiffening {
+        let scales = unit_cases
+            .iter()
+            .map(|k| k.values.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
+            .collect();
+        GeometricStiffening::Inertial { unit_cases, scales }
     }
 
     /// `stress` stiffening.
@@ -149,17 +233,26 @@ impl GeometricStiffening {
     /// The 12 unit load cases' geometric stiffnesses (`inertial` only).
     pub fn unit_cases(&self) -> Option<&[SymmetricCsr]> {
         match self {
-            GeometricStiffening::Inertial { unit_cases } => Some(unit_cases),
+            GeometricStiffening::Inertial { unit_cases, .. } => Some(unit_cases),
             GeometricStiffening::Stress { .. } => None,
         }
     }
 
-    /// A matrix with the pattern of `K_G`.
-    pub fn pattern(mesh: &Mesh) -> SymmetricCsr {
-        stiffness_pattern(mesh)
+    /// A zero matrix with the pattern of `K_G`: the mesh's, or a reduced body's dense one.
+    pub fn pattern(&self, mesh: &Mesh) -> SymmetricCsr {
+        match self {
+            GeometricStiffening::Inertial { unit_cases, .. } => {
+                let mut pattern = unit_cases[0].clone();
+                pattern.values.fill(0.0);
+                pattern
+            }
+            GeometricStiffening::Stress { .. } => stiffness_pattern(mesh),
+        }
     }
 
-    /// Refreshes `k_g` for the state `(x, v, a)` (flat 3N).
+    /// Refreshes `k_g` for the state `(x, v, a)` (flat 3N). `inertial` takes its coefficients
+    /// from the `driving` motion when given (a reduced body's: [`driven_inertial_coefficients`]),
+    /// else from the state ([`inertial_coefficients`]).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
@@ -169,14 +262,28 @@ impl GeometricStiffening {
         x: &[f64],
         v: &[f64],
         a: &[f64],
+        driving: Option<&DrivingAcceleration>,
         k_g: &mut SymmetricCsr,
     ) {
         match self {
-            GeometricStiffening::Inertial { unit_cases } => {
-                let c = inertial_coefficients(body, x, v, a);
-                let terms: [(f64, &SymmetricCsr); 12] =
-                    std::array::from_fn(|k| (c[k], &unit_cases[k]));
-                weighted_sum_into(k_g, &terms);
+            GeometricStiffening::Inertial { unit_cases, scales } => {
+                let c = match driving {
+                    Some(driving) => {
+                        driven_inertial_coefficients(&body.frame_weights.best_fit(x), driving)
+                    }
+                    None => inertial_coefficients(body, x, v, a),
+                };
+                // A term below the sum's round-off (`NEGLIGIBLE_TERM` of the largest) is left
+                // out: a planar motion has 4 terms, the others round-off of the frame's axes.
+                let size = |k: usize| (c[k] * scales[k]).abs();
+                let largest = (0..12).map(size).fold(0.0, f64::max);
+                let mut terms: [(f64, &SymmetricCsr); 12] = [(0.0, &unit_cases[0]); 12];
+                let mut count = 0;
+                for k in (0..12).filter(|&k| size(k) > NEGLIGIBLE_TERM * largest) {
+                    terms[count] = (c[k], &unit_cases[k]);
+                    count += 1;
+                }
+                weighted_sum_into(k_g, &terms[..count]);
             }
             GeometricStiffening::Stress {
                 stresses,

@@ -207,15 +207,16 @@ impl Slave {
             damping_alpha: p.damping_alpha,
             damping_beta: p.damping_beta,
         };
-        let (body, clamped) = if let Some(modes) = p.mode_count() {
+        let (body, clamped, reduced_stiffening) = if let Some(modes) = p.mode_count() {
             self.reduced_body(&matrices, &lumped, options, modes)?
         } else {
             (
                 self.mesh_body(matrices, &lumped, options)?,
                 self.clamped.clone(),
+                None,
             )
         };
-        self.finish_model(key, body, clamped, &lumped)
+        self.finish_model(key, body, clamped, &lumped, reduced_stiffening)
     }
 
     /// For each interface, whether it is a rigid attachment (a force interface, pin or hinge
@@ -314,7 +315,7 @@ impl Slave {
         lumped: &[f64],
         options: BodyOptions,
         modes: ModeCount,
-    ) -> Result<(Body, Vec<bool>)> {
+    ) -> Result<(Body, Vec<bool>, Option<GeometricStiffening>)> {
         self.check_reducible()?;
         // The sets' loads and motions are the mesh's while the basis is built (its attachment
         // modes distribute unit loads over the nodes), not a previous reduction's.
@@ -396,6 +397,29 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
+        let stiffening = if p.stiffening == Stiffening::Inertial {
+            let (stiffness, modal_stiffness) = match &matrices.force_stiffness {
+                Some(k) => (k.clone(), Some(matrices.stiffness_matrix.clone())),
+                None => (matrices.stiffness_matrix.clone(), None),
+            };
+            let mut mesh_body = Body::new(
+                matrices.reference.clone(),
+                matrices.mass_matrix.clone(),
+                stiffness,
+                frame_weights,
+                options,
+            );
+            mesh_body.modal_stiffness = modal_stiffness;
+            Some(GeometricStiffening::inertial_reduced(
+                &self.mesh,
+                &p.material,
+                &mesh_body,
+                &self.clamped,
+                &reduction,
+            )?)
+        } else {
+            None
+        };
         let mut held = reduction.held.iter();
         let mut clamped = vec![false; reduction.field_count];
         for interface in &mut self.interfaces {
@@ -426,7 +450,7 @@ impl Slave {
                 p.frames as usize,
             )?);
         }
-        Ok((body, clamped))
+        Ok((body, clamped, stiffening))
     }
 
     /// The solver's side of a model build: free nodes, constraints, stiffening, `model.auto`'s
@@ -437,6 +461,7 @@ impl Slave {
         mut body: Body,
         clamped: Vec<bool>,
         lumped: &[f64],
+        reduced_stiffening: Option<GeometricStiffening>,
     ) -> Result<()> {
         let started = std::time::Instant::now();
         let free = self.constrained_free_nodes(&body, &clamped)?;
@@ -484,19 +509,18 @@ impl Slave {
         } else {
             None
         };
-        let stiffening = match p.stiffening {
-            Stiffening::Inertial => Some(GeometricStiffening::inertial(
+        let stiffening = match (reduced_stiffening, p.stiffening) {
+            (Some(reduced), _) => Some(reduced),
+            (None, Stiffening::Inertial) => Some(GeometricStiffening::inertial(
                 &self.mesh,
                 &p.material,
                 &body,
                 &self.clamped,
             )?),
-            Stiffening::Stress => Some(GeometricStiffening::stress(&self.mesh, &body)),
-            Stiffening::None => None,
+            (None, Stiffening::Stress) => Some(GeometricStiffening::stress(&self.mesh, &body)),
+            (None, Stiffening::None) => None,
         };
-        if stiffening.is_some() {
-            forces.geometric_stiffness = Some(GeometricStiffening::pattern(&self.mesh));
-        }
+        forces.geometric_stiffness = stiffening.as_ref().map(|s| s.pattern(&self.mesh));
         let allowed = Features {
             nonlinear_forces: p.nonlinear_forces,
             stiffening: stiffening.is_some(),

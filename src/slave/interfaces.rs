@@ -4,6 +4,7 @@
 use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
 use crate::body::frame::{nearest_rotation, node};
 use crate::body::interface::DrivingFrame;
+use crate::body::stiffening::DrivingAcceleration;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
 use crate::fem;
@@ -303,6 +304,37 @@ impl Slave {
             }
         }
         Ok(jumped)
+    }
+
+    /// The rigid motion imposed by the first motion interface at the start of the current step
+    /// (`None` without one): its point, `ω`, and the accelerations over the last communication
+    /// step, `α = (ω_k − ω_{k−1}) / H` and `a_p = (v_k − v_{k−1}) / H` from the driving frames
+    /// at the start of this step and the last (zero before the first step: a driving frame
+    /// moves with constant velocities between its samples). Both frames are part of the FMU
+    /// state (`driving_before` is `driving` until `update_driving_frames`).
+    pub(super) fn driving_acceleration(&self) -> Option<DrivingAcceleration> {
+        let k = self
+            .interfaces
+            .iter()
+            .position(|i| i.kind == InterfaceKind::Motion)?;
+        let (now, before, h) = (
+            &self.driving[k],
+            &self.driving_before[k],
+            self.last_step_size,
+        );
+        let rate = |x: Vector3<f64>, y: Vector3<f64>| {
+            if h > 0.0 {
+                (x - y) / h
+            } else {
+                Vector3::zeros()
+            }
+        };
+        Some(DrivingAcceleration {
+            point: now.position,
+            angular_velocity: now.angular_velocity,
+            angular_acceleration: rate(now.angular_velocity, before.angular_velocity),
+            acceleration: rate(now.velocity, before.velocity),
+        })
     }
 
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or

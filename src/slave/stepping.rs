@@ -421,6 +421,9 @@ impl Slave {
     /// backup.
     fn prepare_step(&mut self, h: f64) -> Result<()> {
         self.prepare_step_size(h)?;
+        // A reduced body's prestress is the driving motion's (docs/formulation.md, "The reduced
+        // body": stiffening from the driving motion).
+        let driving = self.driving_acceleration();
         let model = self
             .model
             .as_mut()
@@ -447,6 +450,7 @@ impl Slave {
                 &s.position,
                 &s.velocity,
                 &s.acceleration,
+                driving.as_ref().filter(|_| model.body.reduction.is_some()),
                 k_g,
             );
         }

@@ -64,7 +64,8 @@ impl Slave {
     }
 
     /// `model.modes > 0` supports a reduced-strain body (one frame or `model.frames` slabs),
-    /// generalized-α or Radau IIA, without stiffening, with pins and hinges on rigid sets only;
+    /// generalized-α or Radau IIA, with `inertial` stiffening only when a motion interface drives
+    /// it, with pins and hinges on rigid sets only;
     /// anything else is an error naming the parameter.
     pub(in crate::slave) fn check_reducible(&self) -> Result<()> {
         let p = &self.parameters;
@@ -72,15 +73,15 @@ impl Slave {
             Some(
                 "model.formulation = full is the nonlinear reference on the whole mesh".to_string(),
             )
-        } else if p.stiffening != Stiffening::None {
-            Some(format!(
-                "model.stiffening = {}: geometric stiffening is not projected on the modes",
-                if p.stiffening == Stiffening::Inertial {
-                    "inertial"
-                } else {
-                    "stress"
-                }
-            ))
+        } else if p.stiffening == Stiffening::Stress {
+            Some("model.stiffening = stress: the stress of the current deformation is not projected on the fields (inertial is)".to_string())
+        } else if p.stiffening == Stiffening::Inertial
+            && !self
+                .interfaces
+                .iter()
+                .any(|i| i.kind == InterfaceKind::Motion)
+        {
+            Some("model.stiffening = inertial: a reduced body takes its prestress from the driving motion of a motion interface, and this body has none (on fixed supports alone the rigid acceleration is zero)".to_string())
         } else if p.integrator == Integrator::CentralDifference {
             Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
         } else {
