@@ -47,25 +47,33 @@ impl IterationMatrix {
                     * (state.pseudo_acceleration[d] - ws.previous.pseudo_acceleration[d]);
             }
         }
-        if body.reduction.is_none() {
-            // The error relative to the body's rigid motion (docs/formulation.md, "Time error
-            // control"): on a body without prescribed nodes the rigid field nearest to `d`; on
-            // one with them the jerk of its rigid motion as a spin (`rigid_jerk`, exact for a
-            // steady spin), whose error the supports take.
-            let (centre, translation, rotation) = if free.clamped.is_empty() {
-                nearest_rigid_field(
-                    &free.nodes,
-                    |k| body.mass_row_sums[free.nodes[k]],
-                    &state.position,
-                    |i| node(&ws.error, i),
-                )
-            } else {
-                let (jerk, omega, centre) = step_change::rigid_jerk(body, state);
-                let h3 = coefficient * h;
-                (centre, h3 * jerk, -h3 * omega.norm_squared() * omega)
-            };
+        // The error relative to the body's rigid motion (docs/formulation.md, "Time error
+        // control"): on a body without prescribed nodes the rigid field nearest to `d`; on one
+        // with them the jerk of its rigid motion as a spin (`rigid_jerk`, exact for a steady
+        // spin), whose error the supports take. The rigid field is affine in the position, so a
+        // reduced body's coordinates take it as a field's coefficients do, `e_k t + B (q_k −
+        // e_k x_c)` (`e_k` the constant field's coefficients, 1 for a node); a reduced body
+        // without prescribed fields keeps `d` as it is (its nearest rigid field is not a sum
+        // over nodes).
+        let rigid = if !free.clamped.is_empty() {
+            let (jerk, omega, centre) = step_change::rigid_jerk(body, state);
+            let h3 = coefficient * h;
+            Some((centre, h3 * jerk, -h3 * omega.norm_squared() * omega))
+        } else if body.reduction.is_none() {
+            Some(nearest_rigid_field(
+                &free.nodes,
+                |k| body.mass_row_sums[free.nodes[k]],
+                &state.position,
+                |i| node(&ws.error, i),
+            ))
+        } else {
+            None
+        };
+        if let Some((centre, translation, rotation)) = rigid {
+            let unit = |i: usize| body.frame_weights.unit(i);
             for &i in &free.nodes {
-                let rigid = translation + rotation.cross(&(node(&state.position, i) - centre));
+                let rigid = unit(i) * translation
+                    + rotation.cross(&(node(&state.position, i) - unit(i) * centre));
                 add_node(&mut ws.error, i, &-rigid);
             }
         }
