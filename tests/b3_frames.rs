@@ -32,7 +32,7 @@ fn run_until(settings: &[(&str, f64)], end: f64) -> (Vec<f64>, f64, Vec<String>)
 
 /// The tip deflection of a run to `end` with `end` as its stop time, as importers define it
 /// (the time error control's horizon), and its internal steps.
-fn run_to_stop(settings: &[(&str, f64)], end: f64) -> (Vec<f64>, u64) {
+fn run_to_stop(settings: &[(&str, f64)], end: f64) -> (Vec<f64>, u64, Vec<String>) {
     let mut s = flexbody::slave::Slave::from_body(b3_body()).unwrap();
     s.setup_experiment(0.0, Some(end), None).unwrap();
     s.enter_initialization_mode().unwrap();
@@ -41,8 +41,8 @@ fn run_to_stop(settings: &[(&str, f64)], end: f64) -> (Vec<f64>, u64) {
     }
     s.exit_initialization_mode().unwrap();
     let mut steps = 0;
-    let (history, ..) = drive_counting(s, end, &mut steps);
-    (history, steps)
+    let (history, _, log) = drive_counting(s, end, &mut steps);
+    (history, steps, log)
 }
 
 /// Steps `s` on the hub schedule to `end`.
@@ -281,14 +281,23 @@ fn a_reduced_body_with_slabs_or_stiffening_follows_full_as_the_mesh_body_does() 
         "the reduced body's stiffening differs from the mesh body's"
     );
 
-    // The same under the time error control with the run as its horizon (the defaults, the
-    // stop time defined): the estimate leaves out the hub's steady spin, whose error the
-    // motion interface takes (docs/formulation.md, "Time error control"), so the steady spin
-    // after 15 s keeps the 10 ms steps. Before, the reduced body's estimate carried the spin's
-    // jerk, 135 times its allowance at 15.02 s, and refined 32-fold: 9 630 internal steps.
-    let (controlled, steps) = run_to_stop(&[("model.stiffening", 2.0), ("model.modes", 8.0)], 20.0);
+    // The defaults plus `model.modes = auto`, under the time error control with the run as its
+    // horizon (the stop time defined, as importers define it). model.auto switches the
+    // stiffening from the driving motion on by itself once it matters to model.accuracy
+    // (docs/formulation.md, "The reduced body"). The estimate leaves out the hub's steady spin,
+    // whose error the motion interface takes ("Time error control"), so the steady spin after
+    // 15 s keeps the 10 ms steps. Before, the reduced body's estimate carried the spin's jerk,
+    // 135 times its allowance at 15.02 s, and refined 32-fold: 9 630 internal steps.
+    let (controlled, steps, log) = run_to_stop(&[("model.modes", -1.0)], 20.0);
     let controlled_e = deviation(&controlled, &full);
-    println!("controlled, the run as the horizon: {controlled_e:.3e} in {steps} internal steps");
+    println!(
+        "model.modes = auto, the run as the horizon: {controlled_e:.3e} in {steps} internal steps; {log:?}"
+    );
+    assert!(
+        log.iter()
+            .any(|m| m.contains("stiffening from the driving motion switched on")),
+        "{log:?}"
+    );
     assert!(
         controlled_e < 0.2 * one_e,
         "controlled {controlled_e}, one frame {one_e}"

@@ -103,6 +103,47 @@ impl LowestModes {
         }
     }
 
+    /// `G_jl = φ_jᵀ A φ_l` of a symmetric matrix `A` on the body's coordinates (`size` = `3N`)
+    /// over the kept modes (1/s² for a stiffness; zero past the computed modes). Allocates;
+    /// set-up only.
+    pub fn project_matrix(&self, a: &SymmetricCsr, size: usize) -> [[f64; MODES]; MODES] {
+        let full: Vec<Vec<f64>> = (0..self.omega_sq.len())
+            .map(|j| {
+                let mut phi = vec![0.0; size];
+                for (k, &i) in self.nodes.iter().enumerate() {
+                    let at = 3 * (MODES * k + j);
+                    phi[3 * i..3 * i + 3].copy_from_slice(&self.modes[at..at + 3]);
+                }
+                phi
+            })
+            .collect();
+        let mut g = [[0.0; MODES]; MODES];
+        let mut y = vec![0.0; size];
+        for (l, phi_l) in full.iter().enumerate() {
+            a.mul_vec(phi_l, &mut y);
+            for (j, phi_j) in full.iter().enumerate() {
+                g[j][l] = crate::linalg::dot(phi_j, &y);
+            }
+        }
+        g
+    }
+
+    /// The relative stiffness change `η` of the kept modes under a geometric stiffness whose
+    /// projection ([`Self::project_matrix`]) is `g` (docs/formulation.md, "The reduced body": when
+    /// the stiffening is taken): the Rayleigh ratio `uᵀ K_G u / uᵀ K u` on their span is
+    /// bounded by the largest absolute row sum of `Λ^-½ G Λ^-½` (Gershgorin),
+    /// `η = max_j Σ_l |G_jl| / (ω_j ω_l)`. For a beam spun at `Ω` it is about `Ω²/ω₁²`.
+    pub fn relative_stiffening(&self, g: &[[f64; MODES]; MODES]) -> f64 {
+        let w = &self.omega_sq;
+        (0..w.len())
+            .map(|j| {
+                (0..w.len())
+                    .map(|l| g[j][l].abs() / (w[j] * w[l]).sqrt())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// `T₁ = 2π/ω₁` (s), the period of the lowest elastic mode.
     pub fn first_period(&self) -> f64 {
         2.0 * std::f64::consts::PI / self.omega_sq[0].sqrt()

@@ -4,7 +4,7 @@
 use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
 use crate::body::feature_indicators::FeatureIndicators;
-use crate::body::lowest_modes::LowestModes;
+use crate::body::lowest_modes::{LowestModes, MODES};
 use crate::body::stiffening::GeometricStiffening;
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{
@@ -83,6 +83,10 @@ pub(super) struct Model {
     pub(super) lowest_modes: Option<LowestModes>,
     /// The step Jacobian's vectors, allocated on its first use (`Slave::step_jacobian`).
     pub(super) jacobian: Option<super::step_jacobian::JacobianWorkspace>,
+    /// A reduced body's stiffening switched by `model.auto` from its driving motion: the twelve
+    /// unit cases projected on the lowest modes, `G_k = Φᵀ K_G,k Φ`
+    /// (`auto_features::choose_driven_stiffening`). `None`: forced as given.
+    pub(super) driven_stiffening: Option<Vec<[[f64; MODES]; MODES]>>,
 }
 
 impl Model {
@@ -397,7 +401,7 @@ impl Slave {
                 started.elapsed().as_secs_f64()
             ),
         });
-        let stiffening = if p.stiffening == Stiffening::Inertial {
+        let stiffening = if self.reduced_stiffening() {
             let (stiffness, modal_stiffness) = match &matrices.force_stiffness {
                 Some(k) => (k.clone(), Some(matrices.stiffness_matrix.clone())),
                 None => (matrices.stiffness_matrix.clone(), None),
@@ -556,6 +560,20 @@ impl Slave {
                 schemes::lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta))
             })
             .transpose()?;
+        let driven_stiffening = match (&lowest_modes, &stiffening) {
+            (Some(modes), Some(stiffening))
+                if body.reduction.is_some() && self.decides_reduced_stiffening() =>
+            {
+                stiffening.unit_cases().map(|cases| {
+                    cases
+                        .iter()
+                        .map(|k| modes.project_matrix(k, body.reference.len()))
+                        .collect()
+                })
+            }
+            _ => None,
+        };
+        let p = &self.parameters;
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
         self.model = Some(Model {
@@ -574,6 +592,7 @@ impl Slave {
             parked_linear: None,
             lowest_modes,
             jacobian: None,
+            driven_stiffening,
         });
         self.dynamics = None;
         // The backups have the old model's size (a changed model.modes changes it).

@@ -3,6 +3,8 @@
 use super::assembly::Model;
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
+use crate::body::lowest_modes::MODES;
+use crate::body::stiffening::{driven_inertial_coefficients, DrivingAcceleration};
 use crate::model::category;
 use nalgebra::Vector3;
 
@@ -108,6 +110,86 @@ pub(super) fn choose_features(
         choose_linear(model, dynamics, accuracy, events);
     }
     model.apply_features(dynamics.features);
+}
+
+/// A reduced body's stiffening from the driving motion is in force while it changes the lowest
+/// modes' stiffness by more than this times `model.accuracy`: a switch applies `f_stiff`, of
+/// about that relative size, as a step load, as the slabs' and the linear body's switches do
+/// ([`LINEAR_AT`]). On B3 the spin-up reaches `η ≈ Ω²/ω₁² ≈ 2.5` (docs/formulation.md, "The
+/// reduced body").
+pub(super) const DRIVEN_STIFFENING_AT: f64 = 0.25;
+
+/// `model.auto`'s stiffening of a reduced body driven by a motion interface (docs/formulation.md,
+/// "The reduced body": when the stiffening is taken): in force from the first communication
+/// point where the relative stiffness change `η` of the lowest modes under the driving motion's
+/// `K_G` ([`crate::body::lowest_modes::LowestModes::relative_stiffening`]) exceeds
+/// [`DRIVEN_STIFFENING_AT`] × `model.accuracy`, out of force once `η` stayed below
+/// [`feature_indicators::HYSTERESIS`] times that for one period `2π/ω₁`. Each switch is logged;
+/// it needs no factorization (`K_G` stays on the right-hand side). O(12 × MODES²), no
+/// allocation unless a decision changes.
+pub(super) fn choose_driven_stiffening(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    accuracy: f64,
+    driving: Option<&DrivingAcceleration>,
+    events: &mut Vec<LogEvent>,
+) {
+    let (Some(projections), Some(modes), Some(driving)) = (
+        model.driven_stiffening.as_ref(),
+        model.lowest_modes.as_ref(),
+        driving,
+    ) else {
+        return;
+    };
+    let s = &dynamics.state;
+    let frame = model.body.frame_weights.best_fit(&s.position);
+    let c = driven_inertial_coefficients(&frame, driving);
+    let mut g = [[0.0; MODES]; MODES];
+    for (ck, gk) in c.iter().zip(projections) {
+        for (row, row_k) in g.iter_mut().zip(gk) {
+            for (x, xk) in row.iter_mut().zip(row_k) {
+                *x += ck * xk;
+            }
+        }
+    }
+    let eta = modes.relative_stiffening(&g);
+    let limit = DRIVEN_STIFFENING_AT * accuracy;
+    let f = &mut dynamics.features;
+    let quiet = &mut dynamics.quiet_since[1];
+    let next = if eta > limit {
+        *quiet = NOT_QUIET;
+        true
+    } else if !f.stiffening {
+        false
+    } else if eta < feature_indicators::HYSTERESIS * limit {
+        if *quiet == NOT_QUIET {
+            *quiet = s.time;
+        }
+        s.time - *quiet < modes.first_period()
+    } else {
+        *quiet = NOT_QUIET;
+        true
+    };
+    if next != f.stiffening {
+        f.stiffening = next;
+        events.push(LogEvent {
+            category: category::EVENTS,
+            message: if next {
+                format!(
+                    "model.auto: at t = {} the reduced body's stiffening from the driving motion switched on: it changes the lowest modes' stiffness by {eta:.3e} > {DRIVEN_STIFFENING_AT} × model.accuracy = {limit:.3e}",
+                    s.time
+                )
+            } else {
+                format!(
+                    "model.auto: at t = {} the reduced body's stiffening from the driving motion switched off: it changed the lowest modes' stiffness by less than {} × {limit:.3e} since t = {} (now {eta:.3e})",
+                    s.time,
+                    feature_indicators::HYSTERESIS,
+                    *quiet
+                )
+            },
+        });
+        *quiet = NOT_QUIET;
+    }
 }
 
 /// The linear body's frame is held while its rotation `θ` against the placement is at most

@@ -49,9 +49,12 @@ impl Slave {
                 frames_refused: false,
                 linear: false,
             },
+            // A reduced body's stiffening from the driving motion starts off when model.auto
+            // switches it (the driving motion is at rest before the first step).
             None => Features {
                 frames: false,
                 linear: false,
+                stiffening: model.allowed.stiffening && model.driven_stiffening.is_none(),
                 ..model.allowed
             },
         };

@@ -1,6 +1,8 @@
 //! `fmi2DoStep`: a communication step as internal steps, with halving retries and rollback.
 
-use super::auto_features::{choose_features, linear_reach_exceeded, LINEAR_AT, NOT_QUIET};
+use super::auto_features::{
+    choose_driven_stiffening, choose_features, linear_reach_exceeded, LINEAR_AT, NOT_QUIET,
+};
 use super::interfaces::extrapolate;
 use super::step_control::{
     finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
@@ -429,6 +431,13 @@ impl Slave {
             .as_mut()
             .expect("prepare_step_size built the model");
         let dynamics = self.dynamics.as_mut().unwrap();
+        choose_driven_stiffening(
+            model,
+            dynamics,
+            self.parameters.accuracy,
+            driving.as_ref(),
+            &mut self.events,
+        );
         choose_features(
             model,
             dynamics,

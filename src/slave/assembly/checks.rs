@@ -63,6 +63,30 @@ impl Slave {
         }
     }
 
+    /// Whether a reduced body carries inertial stiffening from its driving motion
+    /// (docs/formulation.md, "The reduced body"): `model.stiffening = inertial`, or, with a
+    /// motion interface, whatever [`Self::decides_reduced_stiffening`] decides.
+    pub(in crate::slave) fn reduced_stiffening(&self) -> bool {
+        let p = &self.parameters;
+        p.stiffening == Stiffening::Inertial
+            || (p.stiffening == Stiffening::None && self.decides_reduced_stiffening())
+    }
+
+    /// Whether `model.auto` switches a reduced body's stiffening from the driving motion by
+    /// itself, against `model.accuracy` (`slave::auto_features::choose_driven_stiffening`): a
+    /// body driven by a motion interface, generalized-α with `model.accuracy > 0`.
+    pub(in crate::slave) fn decides_reduced_stiffening(&self) -> bool {
+        let p = &self.parameters;
+        p.auto
+            && p.accuracy > 0.0
+            && p.integrator == Integrator::GeneralizedAlpha
+            && p.stiffening != Stiffening::Stress
+            && self
+                .interfaces
+                .iter()
+                .any(|i| i.kind == InterfaceKind::Motion)
+    }
+
     /// `model.modes > 0` supports a reduced-strain body (one frame or `model.frames` slabs),
     /// generalized-α or Radau IIA, with `inertial` stiffening only when a motion interface drives
     /// it, with pins and hinges on rigid sets only;
