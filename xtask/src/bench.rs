@@ -5,6 +5,9 @@
 //! * `step_cost`: the cost of one step against its floor, one pair of triangular solves (the
 //!   reduced body with 8 modes among the bodies, to set beside the peers' CB-8);
 //! * `b3_table`: B3 through the slave for every model choice, `full` as the yardstick (issue 4);
+//! * `b3_step_time`: B3 as an importer drives it (stop time defined, inputs every 10 ms), the
+//!   time inside `do_step` and the error against `full` of the reduced body with
+//!   `model.modes = auto` beside the mesh body (issue 17), interleaved rounds, median;
 //! * `b2_drift`: B2's angular momentum and energy drift with and without `f_nl` and frames;
 //! * `work_precision`: run time against error on B1 and B3 for each formulation (CSV);
 //! * `accuracy_table`: `model.accuracy`'s error achieved against the error requested, and its
@@ -53,6 +56,14 @@ const SUITE: &[Entry] = &[
         example: "b3_table",
         args: &["0.01"],
         quick_args: &["0.01", "40 frames"],
+        csv: None,
+    },
+    Entry {
+        title:
+            "B3 as an importer drives it: time inside do_step, the reduced body against the mesh",
+        example: "b3_step_time",
+        args: &["5"],
+        quick_args: &["1"],
         csv: None,
     },
     Entry {
