@@ -158,6 +158,28 @@ fn model_auto_takes_slabs_once_b3_bends_far() {
     );
     assert!(e_auto < e_one, "{e_auto} against {e_one}");
     assert!(e_auto < 5e-3, "{e_auto}");
+
+    // With inertial stiffening allowed too: it comes on early and goes off with the slabs (it
+    // acts on the one frame's deformation, docs/formulation.md, "Geometric stiffening"). While it
+    // stayed on with them, the example's 40 elements ended 1.3e-2 of the peak off `full`.
+    let (stiffened, _, log) = run_until(&[("model.stiffening", 2.0)], end);
+    let e_stiffened = deviation(&stiffened, &full);
+    println!("stiffening allowed: {:.3} %; {log:?}", 100.0 * e_stiffened);
+    assert!(
+        log.iter()
+            .any(|m| m.contains("slabs") && m.contains("without the geometric stiffening")),
+        "{log:?}"
+    );
+    assert!(e_stiffened < 5e-3, "{e_stiffened}");
+    // Several frames with stiffening are refused by name.
+    let e = refused(
+        b3_body(),
+        &[("model.frames", 5.0), ("model.stiffening", 2.0)],
+    );
+    assert!(
+        e.message.contains("model.frames") && e.message.contains("model.stiffening"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -154,6 +154,7 @@ impl Slave {
         let p = &self.parameters;
         p.material.validate()?;
         self.check_regions()?;
+        self.check_stiffening_frames()?;
         let reference: Vec<f64> = self.mesh.nodes().iter().flatten().copied().collect();
         // HRZ-lumped masses: the frame weights, the patches' weights, the explicit scheme's mass.
         // Material regions: each element's material (the body's outside every region).
