@@ -529,3 +529,31 @@ fn a_step_passed_by_the_iterations_floor_is_named() {
     println!("at the default tolerance {floored_error:.3e} of the peak, at {suggested:e} {tighter_error:.3e}");
     assert!(tighter_error < floored_error);
 }
+
+/// A communication step that fails puts its decisions back (`Slave::do_step`'s roll-back), and
+/// takes their log messages with it: the log tells of no model the next step does not use.
+/// B1 with the defaults is the linear body; pulled by 50 kN at the tip with one iteration
+/// allowed, its step turns the frame beyond the linear body's reach (logged, redone with the
+/// frame following), and the redo does not converge even when retried in smaller steps: the step
+/// fails, and the decision is not in the log (with it kept, this test fails).
+#[test]
+fn a_failed_step_takes_its_decisions_off_the_log() {
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.set_by_name("solver.maxIterations", 1.0).unwrap();
+    s.exit_initialization_mode().unwrap();
+    let h = 1e-3;
+    s.do_step(0.0, h).unwrap();
+    s.drain_events().for_each(drop);
+    s.set_by_name("tip.force[2]", -5e4).unwrap();
+    let e = s.do_step(h, h).unwrap_err();
+    let log: Vec<String> = s.drain_events().map(|e| e.message).collect();
+    println!("{}\n{log:?}", e.message);
+    assert!(e.message.contains("rolled back"), "{}", e.message);
+    assert!(
+        !log.iter()
+            .any(|m| m.starts_with("model.auto:") || m.starts_with("model.accuracy:")),
+        "{log:?}"
+    );
+}

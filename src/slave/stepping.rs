@@ -53,7 +53,7 @@ impl Slave {
             }
         };
         // What a failed step puts back besides the state and the driving frames.
-        let before = StepStart::of(self.dynamics.as_ref().unwrap());
+        let before = StepStart::of(self.dynamics.as_ref().unwrap(), self.events.len());
         // Whether the backup holds this step's start (an error before it must not restore it).
         let mut backed_up = false;
         // A probe takes this step on the rung above (step_control, "probes"), if the step
@@ -588,6 +588,13 @@ impl Slave {
         }
         self.driving.copy_from_slice(&self.driving_before);
         self.outputs.valid = false;
+        // The failed step's decisions are undone, and so are their messages (a switch logged
+        // and rolled back would tell the importer of a model the next step does not use).
+        let mut index = 0;
+        self.events.retain(|event| {
+            index += 1;
+            index <= before.events || !is_decision(&event.message)
+        });
         let kind = e.kind;
         let message = format!(
             "doStep from t = {t_c} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {t_c}{}",
@@ -602,6 +609,13 @@ impl Slave {
     }
 }
 
+/// Whether a log message tells of a decision a failed step undoes: `model.auto`'s terms and
+/// `model.accuracy`'s rungs (not the warnings, the factorizations, which stay cached, or
+/// the counters).
+fn is_decision(message: &str) -> bool {
+    message.starts_with("model.auto:") || message.starts_with("model.accuracy:")
+}
+
 /// What a communication step may change besides the state and the driving frames, as it was at
 /// its start: a failed step puts all of it back, a redone attempt the scales (a rejected
 /// attempt's state, an unresolved ringing's overshoot among others, must not loosen the
@@ -612,16 +626,20 @@ struct StepStart {
     estimate_floor: f64,
     features: super::Features,
     quiet_since: [f64; 3],
+    /// The log events queued before the step: the decisions it logged after them
+    /// (`model.auto`'s switches, `model.accuracy`'s rungs) are undone with it.
+    events: usize,
 }
 
 impl StepStart {
-    fn of(dynamics: &super::Dynamics) -> StepStart {
+    fn of(dynamics: &super::Dynamics, events: usize) -> StepStart {
         StepStart {
             deformation_scale: dynamics.deformation_scale,
             high_mode_scale: dynamics.high_mode_scale,
             estimate_floor: dynamics.estimate_floor,
             features: dynamics.features,
             quiet_since: dynamics.quiet_since,
+            events,
         }
     }
 
