@@ -195,29 +195,37 @@ fn steps_do_not_allocate(settings: &[(&str, f64)]) {
 }
 
 /// A reduced body's inertial stiffening (B3: its prestress from the hub's driving motion) sums
-/// its unit cases into `K_G` in place.
+/// its unit cases into `K_G` in place; forced at the fixed step, and with the defaults, where
+/// `model.auto` decides it every step (on from about 2.45 s) and the error control runs.
 fn reduced_stiffened_steps_do_not_allocate() {
-    let mut s = initialized(
-        example_body("hub_beam"),
-        &[
-            ("model.modes", 4.0),
-            ("model.stiffening", 2.0),
-            ("model.accuracy", 0.0),
-        ],
-    );
-    let drive = common::b3::HubDrive::new(&s);
-    let h = 1e-2;
-    for k in 0..3 {
-        drive.step(&mut s, k as f64 * h, h).unwrap();
+    let forced = [
+        ("model.modes", 4.0),
+        ("model.stiffening", 2.0),
+        ("model.auto", 0.0),
+        ("model.accuracy", 0.0),
+    ];
+    for (settings, warm_up) in [(&forced[..], 3), (&[("model.modes", -1.0)][..], 260)] {
+        let mut s = initialized(example_body("hub_beam"), settings);
+        let drive = common::b3::HubDrive::new(&s);
+        let h = 1e-2;
+        for k in 0..warm_up {
+            drive.step(&mut s, k as f64 * h, h).unwrap();
+        }
+        let log: Vec<String> = s.drain_events().map(|e| e.message).collect();
+        if warm_up > 3 {
+            assert!(
+                log.iter().any(|m| m.contains("switched on")),
+                "the stiffening is on before the steps counted: {log:?}"
+            );
+        }
+        let region = Region::new(GLOBAL);
+        for k in warm_up..warm_up + 20 {
+            drive.step(&mut s, k as f64 * h, h).unwrap();
+        }
+        let stats = region.change();
+        assert!(
+            stats.allocations + stats.reallocations == 0,
+            "allocations in 20 steps of the reduced B3 with stiffening, {settings:?}: {stats:?}"
+        );
     }
-    s.drain_events().for_each(drop);
-    let region = Region::new(GLOBAL);
-    for k in 3..23 {
-        drive.step(&mut s, k as f64 * h, h).unwrap();
-    }
-    let stats = region.change();
-    assert!(
-        stats.allocations + stats.reallocations == 0,
-        "allocations in 20 steps of the reduced B3 with stiffening: {stats:?}"
-    );
 }

@@ -387,9 +387,10 @@ fn a_discarded_step_leaves_the_whole_state_as_it_was() {
     let after = bytes(&s);
     // The counters' place (src/slave/state_bytes.rs): format and interface count (8 bytes), the
     // parameters (270), per interface its inputs, derivatives, sample time and driving frame
-    // (872), the last step size and the start time (16), the stop time (9); four u64 counters.
+    // with its rates (928), the last step size and the start time (16), the stop time (9); four
+    // u64 counters.
     let n = 2;
-    let counters = 303 + 872 * n..303 + 872 * n + 32;
+    let counters = 303 + 928 * n..303 + 928 * n + 32;
     assert_eq!(after.len(), before.len());
     let differ: Vec<usize> = (0..after.len())
         .filter(|&i| after[i] != before[i])
@@ -551,6 +552,22 @@ fn a_failed_step_takes_its_decisions_off_the_log() {
     let log: Vec<String> = s.drain_events().map(|e| e.message).collect();
     println!("{}\n{log:?}", e.message);
     assert!(e.message.contains("rolled back"), "{}", e.message);
+    // The same step with the iterations it needs succeeds, and logs the decision.
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    s.exit_initialization_mode().unwrap();
+    s.do_step(0.0, h).unwrap();
+    s.drain_events().for_each(drop);
+    s.set_by_name("tip.force[2]", -5e4).unwrap();
+    s.do_step(h, h).unwrap();
+    let taken: Vec<String> = s.drain_events().map(|e| e.message).collect();
+    assert!(
+        taken
+            .iter()
+            .any(|m| m.starts_with("model.auto:") && m.contains("redone with the frame following")),
+        "{taken:?}"
+    );
     assert!(
         !log.iter()
             .any(|m| m.starts_with("model.auto:") || m.starts_with("model.accuracy:")),

@@ -267,12 +267,20 @@ impl NodeSet {
 /// A driving frame given by a motion interface's inputs at the start of a communication step:
 /// origin `p`, rotation `Q`, velocity `v` and angular velocity `ω` (global). Over the step it is
 /// extrapolated with constant velocities: `p(τ) = p + v τ`, `Q(τ) = exp([ω τ]×) Q`.
+///
+/// Its velocities change only where the inputs do: `acceleration` and `angular_acceleration`
+/// are their mean rates over the time between the last two changes, `(v_k − v_{k−1}) / Δt`
+/// (m/s², rad/s²; zero before the second), and `changed_at` (s) the time of the last change:
+/// the driving motion's accelerations as a reduced body's stiffening takes them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrivingFrame {
     pub position: Vector3<f64>,
     pub rotation: Matrix3<f64>,
     pub velocity: Vector3<f64>,
     pub angular_velocity: Vector3<f64>,
+    pub acceleration: Vector3<f64>,
+    pub angular_acceleration: Vector3<f64>,
+    pub changed_at: f64,
 }
 
 impl Default for DrivingFrame {
@@ -282,6 +290,9 @@ impl Default for DrivingFrame {
             rotation: Matrix3::identity(),
             velocity: Vector3::zeros(),
             angular_velocity: Vector3::zeros(),
+            acceleration: Vector3::zeros(),
+            angular_acceleration: Vector3::zeros(),
+            changed_at: 0.0,
         }
     }
 }

@@ -76,8 +76,9 @@ pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f
     ]
 }
 
-/// A term of `inertial`'s sum below this fraction of the largest, `|c_k| max|K_G,k|`, is below
-/// the sum's round-off and left out.
+/// A term of `inertial`'s sum below this fraction of the largest, `|c_k| max|K_G,k|` (about
+/// 45 ε), is negligible against it and left out: on a planar motion the others are the
+/// round-off of the frame's axes.
 const NEGLIGIBLE_TERM: f64 = 1e-14;
 
 /// The rigid motion a motion interface imposes (global axes): its point `p` (m), angular
@@ -273,8 +274,8 @@ impl GeometricStiffening {
                     }
                     None => inertial_coefficients(body, x, v, a),
                 };
-                // A term below the sum's round-off (`NEGLIGIBLE_TERM` of the largest) is left
-                // out: a planar motion has 4 terms, the others round-off of the frame's axes.
+                // A term below `NEGLIGIBLE_TERM` of the largest is left out: a planar motion
+                // has 4 terms, the others round-off of the frame's axes.
                 let size = |k: usize| (c[k] * scales[k]).abs();
                 let largest = (0..12).map(size).fold(0.0, f64::max);
                 let mut terms: [(f64, &SymmetricCsr); 12] = [(0.0, &unit_cases[0]); 12];

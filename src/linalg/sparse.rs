@@ -331,8 +331,6 @@ impl BlockCsr3 {
     }
 }
 
-/// The 1D Laplacian tridiag(−1, 2, −1) of size `n` (SPD; eigenvalues `4 sin²(iπ / (2(n+1)))`):
-/// the known matrix of the solver tests.
 /// `Σ a_j x_j` in four independent sums (which the compiler vectorizes).
 fn dense_dot(a: &[f64], x: &[f64]) -> f64 {
     let mut sums = [0.0; 4];
@@ -351,6 +349,8 @@ fn dense_dot(a: &[f64], x: &[f64]) -> f64 {
     (sums[0] + sums[1]) + (sums[2] + sums[3]) + tail
 }
 
+/// The 1D Laplacian tridiag(−1, 2, −1) of size `n` (SPD; eigenvalues `4 sin²(iπ / (2(n+1)))`):
+/// the known matrix of the solver tests.
 #[cfg(test)]
 pub(crate) fn laplacian(n: usize) -> SymmetricCsr {
     let mut t = Vec::new();

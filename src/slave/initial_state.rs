@@ -50,7 +50,7 @@ impl Slave {
                 linear: false,
             },
             // A reduced body's stiffening from the driving motion starts off when model.auto
-            // switches it (the driving motion is at rest before the first step).
+            // switches it: the first step's communication point decides.
             None => Features {
                 frames: false,
                 linear: false,

@@ -148,6 +148,7 @@ pub(super) fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame>
         rotation: rotation_input(name, ".rotation", &values[r..r + 9])?,
         velocity: vector(InterfaceQuantity::Velocity),
         angular_velocity: vector(InterfaceQuantity::AngularVelocity),
+        ..DrivingFrame::default()
     })
 }
 
@@ -292,7 +293,25 @@ impl Slave {
                         rotation,
                         ..old
                     };
-                    jumped |= last > 0.0 && frames_differ(&carried, &frame);
+                    let changed = last > 0.0 && frames_differ(&carried, &frame);
+                    jumped |= changed;
+                    // The velocities' mean rates since their last change (`DrivingFrame`).
+                    let since = t - old.changed_at;
+                    (
+                        frame.acceleration,
+                        frame.angular_acceleration,
+                        frame.changed_at,
+                    ) = if changed && since > 0.0 {
+                        (
+                            (frame.velocity - old.velocity) / since,
+                            (frame.angular_velocity - old.angular_velocity) / since,
+                            t,
+                        )
+                    } else if last > 0.0 {
+                        (old.acceleration, old.angular_acceleration, old.changed_at)
+                    } else {
+                        (Vector3::zeros(), Vector3::zeros(), t)
+                    };
                     self.driving[k] = frame;
                 }
                 InterfaceKind::Force if age == 0.0 => {
@@ -306,34 +325,22 @@ impl Slave {
         Ok(jumped)
     }
 
-    /// The rigid motion imposed by the first motion interface at the start of the current step
-    /// (`None` without one): its point, `ω`, and the accelerations over the last communication
-    /// step, `α = (ω_k − ω_{k−1}) / H` and `a_p = (v_k − v_{k−1}) / H` from the driving frames
-    /// at the start of this step and the last (zero before the first step: a driving frame
-    /// moves with constant velocities between its samples). Both frames are part of the FMU
-    /// state (`driving_before` is `driving` until `update_driving_frames`).
+    /// The rigid motion imposed by the motion interface at the start of the current step
+    /// (`None` without one; a body whose stiffening takes it has exactly one): its point, `ω`,
+    /// and the mean rates of its velocities between their last two changes, `α` and `a_p`
+    /// (`DrivingFrame`: an importer that steps several times per input update gives every
+    /// step the rates over the update's interval). Part of the FMU state with the frame.
     pub(super) fn driving_acceleration(&self) -> Option<DrivingAcceleration> {
         let k = self
             .interfaces
             .iter()
             .position(|i| i.kind == InterfaceKind::Motion)?;
-        let (now, before, h) = (
-            &self.driving[k],
-            &self.driving_before[k],
-            self.last_step_size,
-        );
-        let rate = |x: Vector3<f64>, y: Vector3<f64>| {
-            if h > 0.0 {
-                (x - y) / h
-            } else {
-                Vector3::zeros()
-            }
-        };
+        let now = &self.driving[k];
         Some(DrivingAcceleration {
             point: now.position,
             angular_velocity: now.angular_velocity,
-            angular_acceleration: rate(now.angular_velocity, before.angular_velocity),
-            acceleration: rate(now.velocity, before.velocity),
+            angular_acceleration: now.angular_acceleration,
+            acceleration: now.acceleration,
         })
     }
 
@@ -364,6 +371,7 @@ impl Slave {
                     rotation: Matrix3::from_row_slice(&input[r..r + 9]),
                     velocity: vector(input, InterfaceQuantity::Velocity),
                     angular_velocity: vector(input, InterfaceQuantity::AngularVelocity),
+                    ..DrivingFrame::default()
                 };
                 let (p, q) = frame.at(tau);
                 let at = slot(InterfaceQuantity::Position);

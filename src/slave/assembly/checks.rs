@@ -93,7 +93,9 @@ impl Slave {
 
     /// Whether `model.auto` switches a reduced body's stiffening from the driving motion by
     /// itself, against `model.accuracy` (`slave::auto_features::choose_driven_stiffening`): a
-    /// body driven by a motion interface, generalized-α with `model.accuracy > 0`.
+    /// body held by one motion interface alone, with one frame, no lumped body and no material
+    /// regions (which the stiffening does not support), generalized-α with
+    /// `model.accuracy > 0`.
     pub(in crate::slave) fn decides_reduced_stiffening(&self) -> bool {
         let p = &self.parameters;
         p.auto
@@ -101,10 +103,23 @@ impl Slave {
             && p.frames == 1
             && p.integrator == Integrator::GeneralizedAlpha
             && p.stiffening != Stiffening::Stress
-            && self
-                .interfaces
+            && self.mass_points.is_empty()
+            && self.body_file.regions.is_empty()
+            && self.driven_alone()
+    }
+
+    /// Whether the body is held by exactly one interface, a motion interface: the one whose
+    /// driving motion is the rigid acceleration field of a reduced body's stiffening (with a
+    /// second held interface the body's field is no one interface's).
+    fn driven_alone(&self) -> bool {
+        let held = |kinds: &[InterfaceKind]| {
+            self.interfaces
                 .iter()
-                .any(|i| i.kind == InterfaceKind::Motion)
+                .filter(|i| kinds.contains(&i.kind))
+                .count()
+        };
+        held(&[InterfaceKind::Motion]) == 1
+            && held(&[InterfaceKind::Motion, InterfaceKind::Fixed]) == 1
     }
 
     /// `model.modes > 0` supports a reduced-strain body (one frame or `model.frames` slabs),
@@ -119,13 +134,8 @@ impl Slave {
             )
         } else if p.stiffening == Stiffening::Stress {
             Some("model.stiffening = stress: the stress of the current deformation is not projected on the fields (inertial is)".to_string())
-        } else if p.stiffening == Stiffening::Inertial
-            && !self
-                .interfaces
-                .iter()
-                .any(|i| i.kind == InterfaceKind::Motion)
-        {
-            Some("model.stiffening = inertial: a reduced body takes its prestress from the driving motion of a motion interface, and this body has none (on fixed supports alone the rigid acceleration is zero)".to_string())
+        } else if p.stiffening == Stiffening::Inertial && !self.driven_alone() {
+            Some("model.stiffening = inertial: a reduced body takes its prestress from the driving motion of its motion interface, and this body is not held by exactly one motion interface alone (on fixed supports the rigid acceleration is zero; with two held interfaces the body's field is no one interface's)".to_string())
         } else if p.integrator == Integrator::CentralDifference {
             Some("solver.integrator = centralDifference needs a lumped (diagonal) mass; the reduced mass is dense".to_string())
         } else {
