@@ -59,21 +59,7 @@ pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f
         b += w * r.cross(&ai);
     }
     let alpha = j.try_inverse().unwrap_or_else(Matrix3::zeros) * b;
-    let w = omega;
-    [
-        c_ddot.x,
-        c_ddot.y,
-        c_ddot.z,
-        alpha.x,
-        alpha.y,
-        alpha.z,
-        w.x * w.x,
-        w.y * w.y,
-        w.z * w.z,
-        w.x * w.y,
-        w.x * w.z,
-        w.y * w.z,
-    ]
+    coefficients(&c_ddot, &alpha, &omega)
 }
 
 /// A term of `inertial`'s sum below this fraction of the largest, `|c_k| max|K_G,k|` (about
@@ -103,8 +89,12 @@ pub fn driven_inertial_coefficients(frame: &Frame, driving: &DrivingAcceleration
     let (w, r) = (driving.angular_velocity, frame.origin - driving.point);
     let c_ddot = rt
         * (driving.acceleration + driving.angular_acceleration.cross(&r) + w.cross(&w.cross(&r)));
-    let alpha = rt * driving.angular_acceleration;
-    let w = rt * w;
+    coefficients(&c_ddot, &(rt * driving.angular_acceleration), &(rt * w))
+}
+
+/// The 12 coefficients in their order: `c̈`, `α`, then `ω_a ω_b` for (a, b) = xx, yy, zz, xy,
+/// xz, yz ([`unit_field`]'s order).
+fn coefficients(c_ddot: &Vector3<f64>, alpha: &Vector3<f64>, w: &Vector3<f64>) -> [f64; 12] {
     [
         c_ddot.x,
         c_ddot.y,
