@@ -199,7 +199,7 @@ impl GeometricStiffening {
         Ok(GeometricStiffening::inertial_of(
             unit_cases
                 .iter()
-                .map(|k| reduction.project_matrix(k))
+                .map(|k| reduction.project_geometric_stiffness(k))
                 .collect(),
         ))
     }
