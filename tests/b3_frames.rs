@@ -320,6 +320,12 @@ fn a_reduced_body_with_slabs_or_stiffening_follows_full_as_the_mesh_body_does() 
             .any(|m| m.contains("stiffening from the driving motion switched on")),
         "{log:?}"
     );
+    // The initialization says that it decides (logEvents).
+    assert!(
+        log.iter()
+            .any(|m| m.contains("is switched per communication step")),
+        "{log:?}"
+    );
     assert!(
         controlled_e < 0.2 * one_e,
         "controlled {controlled_e}, one frame {one_e}"

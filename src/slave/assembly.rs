@@ -574,6 +574,17 @@ impl Slave {
             }
             _ => None,
         };
+        if driven_stiffening.is_some() {
+            let accuracy = self.parameters.accuracy;
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "model.auto: the reduced body's inertial stiffening from its motion interface's driving motion is switched per communication step: on while it changes the lowest modes' stiffness by more than {} × model.accuracy = {:.3e}, off once below half of that for a period of the lowest mode (model.auto = false forces model.stiffening as given)",
+                    super::auto_features::DRIVEN_STIFFENING_AT,
+                    super::auto_features::DRIVEN_STIFFENING_AT * accuracy
+                ),
+            });
+        }
         let p = &self.parameters;
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
