@@ -12,6 +12,7 @@
 //! Either way `K_G` is refreshed once per communication step and held during it.
 
 use super::frame::{node, set_node, Frame};
+use super::interface::DrivingFrame;
 use super::reduction::Reduction;
 use super::Body;
 use crate::error::{Error, Result};
@@ -67,26 +68,16 @@ pub fn inertial_coefficients(body: &Body, x: &[f64], v: &[f64], a: &[f64]) -> [f
 /// round-off of the frame's axes.
 const NEGLIGIBLE_TERM: f64 = 1e-14;
 
-/// The rigid motion a motion interface imposes (global axes): its point `p` (m), angular
-/// velocity `ω` (rad/s) and angular acceleration `α` (rad/s²), and the point's acceleration
-/// `a_p` (m/s²).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct DrivingAcceleration {
-    pub point: Vector3<f64>,
-    pub angular_velocity: Vector3<f64>,
-    pub angular_acceleration: Vector3<f64>,
-    pub acceleration: Vector3<f64>,
-}
-
-/// The 12 coefficients of the rigid acceleration field of a driving motion, in the axes of the
+/// The 12 coefficients of the rigid acceleration field of a motion interface's `driving` motion
+/// (its point `p`, `ω`, and the mean rates `α`, `a_p` of [`DrivingFrame`]), in the axes of the
 /// body's co-moving `frame` (docs/formulation.md, "The reduced body": stiffening from the
 /// driving motion): the field's acceleration at the frame's origin `c`,
 /// `c̈ = Rᵀ (a_p + α × r + ω × (ω × r))` with `r = c − p`, then `Rᵀα` and `ω̄_a ω̄_b` with
 /// `ω̄ = Rᵀω`, in the order of [`inertial_coefficients`]. Unlike those, they do not see the
 /// body's own vibration, which through `f_stiff` would feed back on itself.
-pub fn driven_inertial_coefficients(frame: &Frame, driving: &DrivingAcceleration) -> [f64; 12] {
+pub fn driven_inertial_coefficients(frame: &Frame, driving: &DrivingFrame) -> [f64; 12] {
     let rt = frame.rotation.transpose();
-    let (w, r) = (driving.angular_velocity, frame.origin - driving.point);
+    let (w, r) = (driving.angular_velocity, frame.origin - driving.position);
     let c_ddot = rt
         * (driving.acceleration + driving.angular_acceleration.cross(&r) + w.cross(&w.cross(&r)));
     coefficients(&c_ddot, &(rt * driving.angular_acceleration), &(rt * w))
@@ -241,9 +232,9 @@ impl GeometricStiffening {
         }
     }
 
-    /// Refreshes `k_g` for the state `(x, v, a)` (flat 3N). `inertial` takes its coefficients
-    /// from the `driving` motion when given (a reduced body's: [`driven_inertial_coefficients`]),
-    /// else from the state ([`inertial_coefficients`]).
+    /// Refreshes `k_g` for the state `(x, v, a)` (flat 3N). `inertial` takes the `driven`
+    /// coefficients when given (a reduced body's: [`driven_inertial_coefficients`]), else those
+    /// of the state ([`inertial_coefficients`]).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
@@ -253,17 +244,14 @@ impl GeometricStiffening {
         x: &[f64],
         v: &[f64],
         a: &[f64],
-        driving: Option<&DrivingAcceleration>,
+        driven: Option<&[f64; 12]>,
         k_g: &mut SymmetricCsr,
     ) {
         match self {
             GeometricStiffening::Inertial { unit_cases, scales } => {
-                let c = match driving {
-                    Some(driving) => {
-                        driven_inertial_coefficients(&body.frame_weights.best_fit(x), driving)
-                    }
-                    None => inertial_coefficients(body, x, v, a),
-                };
+                let c = driven
+                    .copied()
+                    .unwrap_or_else(|| inertial_coefficients(body, x, v, a));
                 // A term below `NEGLIGIBLE_TERM` of the largest is left out: a planar motion
                 // has 4 terms, the others round-off of the frame's axes.
                 let size = |k: usize| (c[k] * scales[k]).abs();

@@ -4,7 +4,6 @@ use super::assembly::Model;
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
 use crate::body::lowest_modes::MODES;
-use crate::body::stiffening::{driven_inertial_coefficients, DrivingAcceleration};
 use crate::model::category;
 use nalgebra::Vector3;
 
@@ -47,19 +46,7 @@ pub(super) fn choose_features(
                 return;
             };
             let scaled = feature_indicators::SAFETY * e;
-            let next = if *active {
-                if scaled >= feature_indicators::HYSTERESIS * target {
-                    *quiet_since = NOT_QUIET;
-                    true
-                } else {
-                    if *quiet_since == NOT_QUIET {
-                        *quiet_since = s.time;
-                    }
-                    s.time - *quiet_since < dwell
-                }
-            } else {
-                scaled > target
-            };
+            let next = hysteresis(*active, scaled, target, quiet_since, s.time, dwell);
             if next != *active {
                 *active = next;
                 events.push(LogEvent {
@@ -118,6 +105,31 @@ pub(super) fn choose_features(
     model.apply_features(dynamics.features);
 }
 
+/// A switch of `model.auto` with hysteresis: a term that is off goes on when `value` exceeds
+/// `on_above`; one that is on goes off once `value` has stayed below
+/// [`feature_indicators::HYSTERESIS`] × `on_above` for `dwell` (s) since `quiet_since` (the time
+/// it fell below, [`NOT_QUIET`] while it is not), which this keeps, at time `time`.
+fn hysteresis(
+    active: bool,
+    value: f64,
+    on_above: f64,
+    quiet_since: &mut f64,
+    time: f64,
+    dwell: f64,
+) -> bool {
+    if !active {
+        return value > on_above;
+    }
+    if value >= feature_indicators::HYSTERESIS * on_above {
+        *quiet_since = NOT_QUIET;
+        return true;
+    }
+    if *quiet_since == NOT_QUIET {
+        *quiet_since = time;
+    }
+    time - *quiet_since < dwell
+}
+
 /// A reduced body's stiffening from the driving motion is in force while it changes the lowest
 /// modes' stiffness by more than this times `model.accuracy`: a switch applies `f_stiff`, of
 /// about that relative size, as a step load, as the slabs' and the linear body's switches do
@@ -126,9 +138,10 @@ pub(super) fn choose_features(
 pub(super) const DRIVEN_STIFFENING_AT: f64 = 0.25;
 
 /// `model.auto`'s stiffening of a reduced body driven by a motion interface (docs/formulation.md,
-/// "The reduced body": when the stiffening is taken): in force from the first communication
-/// point where the relative stiffness change `η` of the lowest modes under the driving motion's
-/// `K_G` ([`crate::body::lowest_modes::LowestModes::relative_stiffening`]) exceeds
+/// "The reduced body": when the stiffening is taken), from its `driven` coefficients
+/// ([`crate::body::stiffening::driven_inertial_coefficients`]): in force from the first
+/// communication point where the relative stiffness change `η` of the lowest modes under the
+/// driving motion's `K_G` ([`crate::body::lowest_modes::LowestModes::relative_stiffening`]) exceeds
 /// [`DRIVEN_STIFFENING_AT`] × `model.accuracy`, out of force once `η` stayed below
 /// [`feature_indicators::HYSTERESIS`] times that for one period `2π/ω₁`. Each switch is logged;
 /// it needs no factorization (`K_G` stays on the right-hand side). O(12 × MODES²), no
@@ -137,19 +150,17 @@ pub(super) fn choose_driven_stiffening(
     model: &Model,
     dynamics: &mut Dynamics,
     accuracy: f64,
-    driving: Option<&DrivingAcceleration>,
+    driven: Option<&[f64; 12]>,
     events: &mut Vec<LogEvent>,
 ) {
-    let (Some(projections), Some(modes), Some(driving)) = (
+    let (Some(projections), Some(modes), Some(c)) = (
         model.driven_stiffening.as_ref(),
         model.lowest_modes.as_ref(),
-        driving,
+        driven,
     ) else {
         return;
     };
     let s = &dynamics.state;
-    let frame = model.body.frame_weights.best_fit(&s.position);
-    let c = driven_inertial_coefficients(&frame, driving);
     let mut g = [[0.0; MODES]; MODES];
     for (ck, gk) in c.iter().zip(projections) {
         for (row, row_k) in g.iter_mut().zip(gk) {
@@ -162,20 +173,14 @@ pub(super) fn choose_driven_stiffening(
     let limit = DRIVEN_STIFFENING_AT * accuracy;
     let f = &mut dynamics.features;
     let quiet = &mut dynamics.quiet_since[1];
-    let next = if eta > limit {
-        *quiet = NOT_QUIET;
-        true
-    } else if !f.stiffening {
-        false
-    } else if eta < feature_indicators::HYSTERESIS * limit {
-        if *quiet == NOT_QUIET {
-            *quiet = s.time;
-        }
-        s.time - *quiet < modes.first_period()
-    } else {
-        *quiet = NOT_QUIET;
-        true
-    };
+    let next = hysteresis(
+        f.stiffening,
+        eta,
+        limit,
+        quiet,
+        s.time,
+        modes.first_period(),
+    );
     if next != f.stiffening {
         f.stiffening = next;
         events.push(LogEvent {

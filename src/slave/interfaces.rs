@@ -4,7 +4,6 @@
 use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
 use crate::body::frame::{nearest_rotation, node};
 use crate::body::interface::DrivingFrame;
-use crate::body::stiffening::DrivingAcceleration;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
 use crate::fem;
@@ -325,23 +324,15 @@ impl Slave {
         Ok(jumped)
     }
 
-    /// The rigid motion imposed by the motion interface at the start of the current step
-    /// (`None` without one; a body whose stiffening takes it has exactly one): its point, `ω`,
-    /// and the mean rates of its velocities between their last two changes, `α` and `a_p`
-    /// (`DrivingFrame`: an importer that steps several times per input update gives every
-    /// step the rates over the update's interval). Part of the FMU state with the frame.
-    pub(super) fn driving_acceleration(&self) -> Option<DrivingAcceleration> {
+    /// The driving frame of the motion interface at the start of the current step, with the
+    /// mean rates of its velocities between their last two changes (`None` without one; a body
+    /// whose stiffening takes it has exactly one). Part of the FMU state.
+    pub(super) fn motion_frame(&self) -> Option<&DrivingFrame> {
         let k = self
             .interfaces
             .iter()
             .position(|i| i.kind == InterfaceKind::Motion)?;
-        let now = &self.driving[k];
-        Some(DrivingAcceleration {
-            point: now.position,
-            angular_velocity: now.angular_velocity,
-            angular_acceleration: now.angular_acceleration,
-            acceleration: now.acceleration,
-        })
+        Some(&self.driving[k])
     }
 
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or

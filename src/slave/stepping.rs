@@ -8,6 +8,7 @@ use super::step_control::{
     finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
 };
 use super::{LogEvent, Slave};
+use crate::body::stiffening::driven_inertial_coefficients;
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
@@ -423,19 +424,25 @@ impl Slave {
     /// backup.
     fn prepare_step(&mut self, h: f64) -> Result<()> {
         self.prepare_step_size(h)?;
-        // A reduced body's prestress is the driving motion's (docs/formulation.md, "The reduced
-        // body": stiffening from the driving motion).
-        let driving = self.driving_acceleration();
+        let motion = self.motion_frame().copied();
+        let dynamics = self.dynamics.as_mut().unwrap();
         let model = self
             .model
             .as_mut()
             .expect("prepare_step_size built the model");
-        let dynamics = self.dynamics.as_mut().unwrap();
+        // A reduced body's prestress is the driving motion's (docs/formulation.md, "The reduced
+        // body": stiffening from the driving motion), in the body's axes at the step's start.
+        let driven = motion
+            .filter(|_| model.body.reduction.is_some() && model.stiffening.is_some())
+            .map(|driving| {
+                let frame = model.body.frame_weights.best_fit(&dynamics.state.position);
+                driven_inertial_coefficients(&frame, &driving)
+            });
         choose_driven_stiffening(
             model,
             dynamics,
             self.parameters.accuracy,
-            driving.as_ref(),
+            driven.as_ref(),
             &mut self.events,
         );
         choose_features(
@@ -459,7 +466,7 @@ impl Slave {
                 &s.position,
                 &s.velocity,
                 &s.acceleration,
-                driving.as_ref().filter(|_| model.body.reduction.is_some()),
+                driven.as_ref(),
                 k_g,
             );
         }
