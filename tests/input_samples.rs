@@ -172,47 +172,30 @@ fn the_sample_times_are_part_of_the_fmu_state() {
     assert_eq!(drive.tip_deflection(&mut fresh, 0.52).unwrap(), expected);
 }
 
-/// The same B3 under the error control (`model.accuracy = 1e-3`) with two half steps per input
-/// update: at 1.67 s `model.auto` switches on its slabs and the control refines, after which the
-/// estimates on the fine rungs no longer fall with the step (docs/formulation.md, "Probes").
-/// Without probes the internal step stayed on 0.16 ms for the rest of the run, 16 times the work
-/// of whole steps; with them the body climbs back up, each climb logged. The whole steps take
-/// one 10 ms internal step per update (nothing to estimate after an input jump), so the curves
-/// differ by the time integration error of 10 ms steps: 2.0e-3 of B3's 0.57 m peak over the 20 s
-/// (the full formulation at 10 ms against 2.5 ms, docs/formulation.md "Probes"); the first 3 s
-/// are compared against that bound.
+/// B3 at `model.accuracy = 1e-3` for 3 s, its hub inputs set every 10 ms, once with one step
+/// per input update and once with two half steps. The internal steps after a motion input's
+/// jump are not estimated (`MOTION_RINGING_STEPS`: the kink of the hub's sampled motion rings in
+/// the held coordinates' accelerations, which the estimate reads as error), so the split run is
+/// judged as the whole one and takes its half steps on the top rung: twice the whole run's
+/// internal steps. Before, its second half steps were estimated on that ringing: it refined to
+/// 0.16 ms at the slabs' switch and took 4 094 internal steps against 300 over these 3 s
+/// (13.6 times), and over 20 s 479 460 against 3 506.
 #[test]
-fn an_importer_that_splits_steps_does_not_trap_the_error_control_on_a_fine_rung() {
+fn an_importer_that_splits_steps_is_judged_as_one_that_steps_once() {
     let settings = [("model.accuracy", 1e-3)];
-    let (mut worst, mut finest, mut climbs) = (0.0_f64, f64::INFINITY, Vec::new());
-    let (whole, split) = whole_and_split(&settings, 300, |split, y_split, y_whole, t| {
+    let (mut worst, mut finest) = (0.0_f64, f64::INFINITY);
+    let (whole, split) = whole_and_split(&settings, 300, |split, y_split, y_whole, _| {
         worst = worst.max((y_split - y_whole).abs());
         finest = finest.min(split.controlled_step_size());
-        let rung = split.controlled_step_size();
-        if split
-            .drain_events()
-            .any(|e| e.message.contains("(a probe)"))
-        {
-            climbs.push((t, rung));
-        }
     });
-    let end = split.controlled_step_size();
-    println!(
-        "finest rung {finest:e} s, at 3 s {end:e} s; probes that climbed: {climbs:?}; internal steps split {}, whole {}; largest difference {worst:.3e} m",
-        split.solver_statistics().0,
-        whole.solver_statistics().0
-    );
-    assert!(
-        finest < 1e-3,
-        "the slabs' switch refines: finest rung {finest}"
-    );
-    assert!(!climbs.is_empty(), "no probe climbed back up");
-    // Trapped on its finest rung the split run took 22 internal steps per half step from
-    // 1.67 s on: 334 + 266 × 22 = 6 186 internal steps, 20.6 times the whole steps' 300 over
-    // these 3 s. Measured with probes: 4 094 (13.6 times).
     let (split_steps, whole_steps) = (split.solver_statistics().0, whole.solver_statistics().0);
+    println!(
+        "finest rung {finest:e} s; internal steps split {split_steps}, whole {whole_steps}; largest difference {worst:.3e} m"
+    );
+    // Two half steps per update, each one internal step; a few redone (the first steps, before
+    // any input jumps, are estimated).
     assert!(
-        split_steps <= 15 * whole_steps,
+        split_steps <= 2 * whole_steps + 20,
         "the split run took {split_steps} internal steps against {whole_steps}"
     );
     assert!(
@@ -250,6 +233,10 @@ fn the_driving_frames_of_the_last_step_are_part_of_the_fmu_state() {
     s.set_state(&saved).unwrap();
     s.do_step(6.0 * h, h).unwrap();
     println!("internal steps {taken}, tip y {expected:e}");
+    // The jump came after a calm stretch (a step of the driving velocity, not a sampled motion):
+    // only its first internal step goes unestimated, and the control refines for the body's
+    // response (35 internal steps; 8 unestimated steps would take one and end 6 % off).
+    assert!(taken > 1, "the step after a jump from calm was not refined");
     assert_eq!(s.solver_statistics().0 - steps, taken);
     assert_eq!(get(&mut s, "tip.position[2]").to_bits(), expected.to_bits());
     // Through the byte form into a fresh instance.

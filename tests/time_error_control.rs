@@ -225,8 +225,10 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     // refines to 0.5 ms at the step load. From 5 ms the master changes the tip load at
     // every step, and the ladder is made due for a probe (its calm steps set in the FMU state's
     // bytes: the payload ends with the rung, the calm steps and the probe's wait as u32, whether
-    // the rung came from a probe as u8, then the deformation scale, the scale of the modes above
-    // the lowest, the estimate floor and the last internal step as f64). On the rung above, one internal
+    // the rung came from a probe as u8, the internal steps since a motion input jumped as u32 and whether the
+    // motion is sampled as u8,
+    // then the deformation scale, the scale of the modes above the lowest, the estimate floor and
+    // the last internal step as f64). On the rung above, one internal
     // step after an input jump, nothing would be estimated, so the probe could not be judged:
     // none is taken, and the step takes its two estimated internal steps of 0.5 ms.
     let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
@@ -248,9 +250,9 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     let mut bytes = Vec::new();
     flexbody::slave::CoSimSlave::state_to_bytes(&s, &s.get_state(), &mut bytes);
     // From the payload's end (src/slave/state_bytes.rs): the last internal step, the estimate
-    // floor and the two scales (f64 each), whether the rung came from a probe (u8), the probe's
-    // wait and before it the calm steps (u32 each).
-    let wait_at = bytes.len() - 4 * 8 - 1 - 4;
+    // floor and the two scales (f64 each), the steps since a motion input jumped (u32) and whether it is sampled (u8), whether
+    // the rung came from a probe (u8), the probe's wait and before it the calm steps (u32 each).
+    let wait_at = bytes.len() - 4 * 8 - 1 - 4 - 1 - 4;
     let calm_at = wait_at - 4;
     let wait = u32::from_le_bytes(bytes[wait_at..wait_at + 4].try_into().unwrap());
     bytes[calm_at..calm_at + 4].copy_from_slice(&wait.to_le_bytes());

@@ -196,6 +196,11 @@ pub struct Slave {
     step_estimate: f64,
     /// Whether an input jumped at the start of the communication step under way.
     inputs_jumped: bool,
+    /// Whether a motion interface's inputs jumped there.
+    motion_jumped: bool,
+    /// Internal steps since a motion input last jumped, at the start of the communication step
+    /// under way (`step_control::MOTION_RINGING_STEPS`).
+    since_motion_jump: u32,
     /// Scratch of `3N`: `K ū` for the deformation scale, `ū` of the state for `model.auto`.
     scale_scratch: Vec<f64>,
     /// Messages for the logger, drained by the FMI layer after each call.
@@ -299,6 +304,8 @@ impl Slave {
             step_error_unfloored: 0.0,
             step_estimate: 0.0,
             inputs_jumped: false,
+            motion_jumped: false,
+            since_motion_jump: 0,
             scale_scratch: Vec::new(),
             events: Vec::new(),
             results: None,

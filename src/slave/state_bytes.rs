@@ -17,7 +17,7 @@
 //! | stop time | u8 (1: defined), f64 (0 when not) |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused); since when their indicators are quiet [2] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 11;
+pub const PAYLOAD_FORMAT: u32 = 12;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -237,6 +237,8 @@ impl SlaveState {
                 w.u32(d.ladder.calm_steps);
                 w.u32(d.ladder.probe_after);
                 w.u8(u8::from(d.ladder.probed));
+                w.u32(d.ladder.since_motion_jump);
+                w.u8(u8::from(d.ladder.sampled_motion));
                 w.f64(d.deformation_scale);
                 w.f64(d.high_mode_scale);
                 w.f64(d.estimate_floor);
@@ -460,6 +462,17 @@ impl Slave {
                         "the serialized FMU state holds {probe_after} for the steps the next probe waits for: not within {probe_range:?}"
                     )));
                 }
+                let since_motion_jump =
+                    r.u32("the internal steps since a motion input last jumped")?;
+                let sampled_motion = match r.u8("whether the motion inputs are sampled")? {
+                    0 => false,
+                    1 => true,
+                    b => {
+                        return Err(Error::new(format!(
+                            "the serialized FMU state holds {b} for whether the motion inputs are sampled: not 0 or 1"
+                        )))
+                    }
+                };
                 let deformation_scale = r.f64("the deformation scale")?;
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
                 let estimate_floor = r.f64("the estimate floor")?;
@@ -500,6 +513,8 @@ impl Slave {
                         calm_steps,
                         probe_after,
                         probed,
+                        since_motion_jump,
+                        sampled_motion,
                     },
                     deformation_scale,
                     high_mode_scale,

@@ -88,6 +88,19 @@ pub const PROBE_BELOW: f64 = 0.5;
 /// step (a driven body sampled by its importer: B3) are named within the first 10 steps.
 pub const UNESTIMATED_WARN_AFTER: u32 = 10;
 
+/// Internal steps after a motion input's jump that are not estimated when the motion is sampled
+/// (the jump came within as many internal steps of the one before: a driven body whose importer
+/// sets its motion at every update). Each jump is a kink of the held coordinates' prescribed
+/// path; their accelerations follow it through the scheme's update formulas, whose recurrence
+/// rings with the factor `−α_m / (1 − α_m)` per step (−0.72 at `ρ∞ = 0.9`), and the estimate of
+/// the next steps reads that ringing, which does not fall with the step, as their error
+/// (docs/formulation.md, "The steps after a motion input's jump"). After 8 steps it is 0.72⁸ =
+/// 7 % of what it was. So an importer that steps twice per input update (B3 as two half steps)
+/// is judged as one that steps once: neither is estimated. A jump after a calm stretch (a step
+/// of the driving velocity) leaves only its first internal step unestimated, as a force
+/// input's does: the body's response to it is what the estimate must follow.
+pub const MOTION_RINGING_STEPS: u32 = 8;
+
 /// Where the internal step stands on the ladder between communication steps (part of the FMU
 /// state).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,6 +114,11 @@ pub struct Ladder {
     /// Whether this rung was reached by a probe that has not yet been confirmed by as many
     /// calm steps as the next probe waits for.
     pub probed: bool,
+    /// Internal steps since a motion input last jumped (saturating; [`MOTION_RINGING_STEPS`]).
+    pub since_motion_jump: u32,
+    /// Whether that jump came within [`MOTION_RINGING_STEPS`] of the one before (a sampled
+    /// motion, whose next internal steps are not estimated).
+    pub sampled_motion: bool,
 }
 
 impl Default for Ladder {
@@ -110,6 +128,8 @@ impl Default for Ladder {
             calm_steps: 0,
             probe_after: PROBE_FIRST,
             probed: false,
+            since_motion_jump: MOTION_RINGING_STEPS,
+            sampled_motion: false,
         }
     }
 }
@@ -167,9 +187,14 @@ impl Ladder {
                 calm_steps: 0,
                 probe_after: (2 * self.probe_after).min(PROBE_LAST),
                 probed: false,
+                ..self
             }
         } else {
-            Ladder::on(level)
+            Ladder {
+                since_motion_jump: self.since_motion_jump,
+                sampled_motion: self.sampled_motion,
+                ..Ladder::on(level)
+            }
         }
     }
 

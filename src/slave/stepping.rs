@@ -5,7 +5,8 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
+    finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS, NOISE_MARGIN,
+    UNESTIMATED_WARN_AFTER,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
@@ -40,18 +41,30 @@ impl Slave {
         // give the same bits in every importer.
         let t0 = self.time();
         let controlled = self.error_controlled();
-        let ladder = self.dynamics.as_ref().unwrap().ladder;
+        let mut ladder = self.dynamics.as_ref().unwrap().ladder;
         let slabs_before = self.dynamics.as_ref().unwrap().features.frames;
         self.jacobian_step = None;
         // The driving frames of the last step, put back if this one is rolled back (they tell
         // the next step whether its inputs jump).
         self.driving_before.copy_from_slice(&self.driving);
-        self.inputs_jumped = match self.update_driving_frames() {
+        (self.inputs_jumped, self.motion_jumped) = match self.update_driving_frames() {
             Ok(jumped) => jumped,
             Err(e) => {
                 self.driving.copy_from_slice(&self.driving_before);
                 return Err(e);
             }
+        };
+        if self.motion_jumped {
+            // The kink a motion input's jump puts in the held coordinates' path rings for the
+            // next internal steps, which are not estimated if the motion is sampled
+            // (`MOTION_RINGING_STEPS`).
+            ladder.sampled_motion = ladder.since_motion_jump < MOTION_RINGING_STEPS;
+            ladder.since_motion_jump = 0;
+        }
+        self.since_motion_jump = if ladder.sampled_motion {
+            ladder.since_motion_jump
+        } else {
+            MOTION_RINGING_STEPS
         };
         // What a failed step puts back besides the state and the driving frames.
         let before = StepStart::of(self.dynamics.as_ref().unwrap(), self.events.len());
@@ -308,6 +321,10 @@ impl Slave {
                 } else {
                     ladder.after_step(self.step_error)
                 };
+                dynamics.ladder.since_motion_jump = ladder
+                    .since_motion_jump
+                    .saturating_add(u32::try_from(taken.0).unwrap_or(u32::MAX));
+                dynamics.ladder.sampled_motion = ladder.sampled_motion;
                 if controlled {
                     self.count_unestimated(t0 + big_h, taken.1);
                 }

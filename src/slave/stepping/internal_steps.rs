@@ -3,7 +3,9 @@
 //! for one (docs/formulation.md, "Time error control").
 
 use super::super::interfaces::{apply_loads, prescribe_motion};
-use super::super::step_control::{allowance, error_ratio, GROW_BELOW, ITERATION_NOISE};
+use super::super::step_control::{
+    allowance, error_ratio, GROW_BELOW, ITERATION_NOISE, MOTION_RINGING_STEPS,
+};
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
 use crate::body::lowest_modes::LowestModes;
@@ -96,6 +98,12 @@ impl Slave {
         };
         let controlled = self.error_controlled();
         let jumped = self.inputs_jumped;
+        // Internal steps since a motion input's jump before this call's first.
+        let since_motion_jump = u64::from(self.since_motion_jump);
+        let ringing = |j: usize| {
+            let before = (tau0 / hs).round() as u64 + j as u64;
+            since_motion_jump + before < u64::from(MOTION_RINGING_STEPS)
+        };
         // The allowance of these internal steps, from the deformation scale (updated after
         // each step that is estimated, and at the end of each communication step).
         let horizon = self.error_horizon();
@@ -157,8 +165,8 @@ impl Slave {
             // the inputs jump) and on the last (where the outputs are read): docs/formulation.md,
             // "Time error control".
             let first = tau0 == 0.0 && j == 0;
-            settings.estimate_error = (controlled && (last || first) && !(first && jumped))
-                .then_some(
+            settings.estimate_error =
+                (controlled && (last || first) && !(first && jumped) && !ringing(j)).then_some(
                     GROW_BELOW * allowed(dynamics.deformation_scale) / std::f64::consts::SQRT_2,
                 );
             let report = model.integrator.step(
