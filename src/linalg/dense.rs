@@ -43,13 +43,17 @@ impl DenseSymmetric {
         self.matrix.nrows()
     }
 
-    /// `y = A x` (length `n`). No allocation.
+    /// `y = A x` (length `n`). No allocation. `A` is symmetric, so its column-major storage
+    /// is `Aᵀ` row-major: faer multiplies that with its dot-product kernel (each row against
+    /// `x`, the sums in registers) instead of the column kernel, which reads and writes all of
+    /// `y` once per column. B1's reduced linear step (`3s` = 129 and 138) takes 0.89 of the
+    /// time it took (median of 6 interleaved runs, bench/results/2026-11-27-paired-2.md).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
         let n = self.dim();
         matmul(
             MatMut::from_column_major_slice_mut(y, n, 1),
             Accum::Replace,
-            self.matrix.as_ref(),
+            self.matrix.as_ref().transpose(),
             MatRef::from_column_major_slice(x, n, 1),
             1.0,
             Par::Seq,
