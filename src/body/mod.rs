@@ -16,7 +16,7 @@ pub use frame::{Frame, FrameWeights};
 pub use interface::NodeSet;
 pub use lumped_body::LumpedBody;
 pub use patches::Patches;
-pub use reduction::{InterfaceSets, MeshData, ModeChoice, ModeCount, Reduction};
+pub use reduction::{InterfaceSets, MeshData, ModeChoice, ModeCount, Reduction, SecondOrderForce};
 
 use crate::fem::nonlinear::SvkSolid;
 use crate::linalg::dense::DenseSymmetric;

@@ -40,6 +40,9 @@
 //! 4. attachment modes: for each force interface, the static response to a unit force and a
 //!    unit torque in each direction, distributed as the interface distributes them (boundary
 //!    held; with inertia relief when there is no boundary set);
+//! 5. with several frames (`model.frames > 1`, a supported body), the modal derivatives of the
+//!    fixed-interface and attachment modes: `ψ = −K_ii⁻¹ f₂(φ)`, `f₂` the slabs' elastic force
+//!    to second order (docs/formulation.md, "The reduced body": several frames);
 //!
 //! each vector mode contributing its three components as scalar fields. The basis is then
 //! rearranged so that on boundary set `j` exactly `a_j` fields are non-zero, and there they are
@@ -67,8 +70,8 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 mod construction;
 use construction::{
     attachment_modes, barycentric_fields, basis_fields, boundary_coefficients, candidate_fields,
-    constraint_modes, expanded_frame, fixed_interface_modes, held_coordinates, reduced_mass,
-    reduced_stiffness, InteriorSolve,
+    constraint_modes, expanded_frame, fixed_interface_modes, held_coordinates, modal_derivatives,
+    reduced_mass, reduced_stiffness, InteriorSolve,
 };
 
 /// Scalar fields from a vector mode whose mass norm is below this fraction of the mode's
@@ -167,9 +170,12 @@ pub struct Reduction {
     pub mode_choice: Option<ModeChoice>,
 }
 
+/// `f₂(u)` written into its second argument ([`MeshData::second_order_force`]).
+pub type SecondOrderForce<'f> = dyn Fn(&[f64], &mut [f64]) + 'f;
+
 /// The mesh data a reduction starts from (`N` nodes: the mesh's, then any lumped body's mass
 /// points).
-#[derive(Debug, Clone, Copy)]
+#[derive(Clone, Copy)]
 pub struct MeshData<'a> {
     /// Reference positions `X` (flat `3N`, m).
     pub reference: &'a [f64],
@@ -184,6 +190,11 @@ pub struct MeshData<'a> {
     pub lumped: &'a [f64],
     /// The co-moving frame's weights per node (the lumped masses, zero on mass points).
     pub frame_weights: &'a [f64],
+    /// The second-order internal force `f₂(u)` of a displacement `u` (flat `3N`, N): the
+    /// part of the elastic force quadratic in `u`, `f(X + u) = K u + f₂(u) + O(u³)`. Given for
+    /// a body with several frames (the slabs' force): the modal derivatives of the basis, see
+    /// the module documentation.
+    pub second_order_force: Option<&'a SecondOrderForce<'a>>,
 }
 
 /// The interfaces' node sets as the reduction treats them.
@@ -221,9 +232,13 @@ impl Reduction {
         let mut vectors: Vec<Vec<f64>> = Vec::new();
         let set_functions =
             constraint_modes(&mut solve, stiffness, reference, boundary, &mut vectors);
+        let first_mode = vectors.len();
         let (mode_eigenvalues, mode_choice) =
             fixed_interface_modes(&mut solve, modes, reference, lumped, &mut vectors)?;
         attachment_modes(&mut solve, reference, lumped, loaded, &mut vectors);
+        if let Some(second_order_force) = mesh.second_order_force {
+            modal_derivatives(&mut solve, second_order_force, first_mode, &mut vectors);
+        }
         let candidates = candidate_fields(&vectors, mass, reference, n);
         let coefficients = boundary_coefficients(&candidates, boundary, &set_functions, reference)?;
         let (mut fields, held_count) = basis_fields(&coefficients, &candidates, mass, n)?;

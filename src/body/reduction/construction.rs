@@ -319,6 +319,32 @@ pub(super) fn attachment_modes(
     }
 }
 
+/// The static modal derivatives of the vector modes `vectors[first..]` (the fixed-interface and
+/// attachment modes), appended to `vectors`: for each mode `φ` the second-order static response
+/// `ψ = −K_ii⁻¹ f₂(φ)` with the boundary held, `f₂` the part of the full formulation's internal
+/// force quadratic in the displacement (`second_order_force`). It holds what goes with `φ` at
+/// second order, the axial shortening of a bending shape, which several frames need: each slab
+/// turns with the body's bending, and a basis without it strains the body along its axis when
+/// the slabs turn (docs/formulation.md, "The reduced body": several frames). An unsupported
+/// body gets none (its solve is shifted; a free body's slabs are not measured).
+pub(super) fn modal_derivatives(
+    solve: &mut InteriorSolve,
+    second_order_force: &dyn Fn(&[f64], &mut [f64]),
+    first: usize,
+    vectors: &mut Vec<Vec<f64>>,
+) {
+    if solve.free_body {
+        return;
+    }
+    let mut force = vec![0.0; solve.n3];
+    for k in first..vectors.len() {
+        second_order_force(&vectors[k], &mut force);
+        let mut rhs: Vec<f64> = solve.interior.iter().map(|&dof| -force[dof]).collect();
+        solve.factor.solve_in_place(&mut rhs, &mut solve.workspace);
+        vectors.push(solve.expand(&rhs));
+    }
+}
+
 /// The candidate scalar fields, of unit mass norm: the affine fields, then the components of
 /// the vector modes (those not vanishing by symmetry).
 pub(super) fn candidate_fields(
