@@ -354,8 +354,8 @@ impl Slave {
             .map(|i| if i < mesh_nodes { lumped[i] } else { 0.0 })
             .collect();
         // Several frames need the basis's second order (`modal_derivatives`): `f₂(u)` of the
-        // slabs' own elastic force, `(f(X + εu) + f(X − εu)) / (2ε²)` (the odd orders cancel),
-        // `ε` scaling `u` to 1e-3 of the body's size.
+        // slabs' own elastic force (with `f_nl` if it is on), `(f(X + εu) + f(X − εu)) / (2ε²)`
+        // (the odd orders cancel), `ε` scaling `u` to 1e-3 of the body's size.
         let slabs = if p.frames > 1 {
             Some(Patches::along_principal_axis(
                 &self.mesh,
@@ -384,7 +384,7 @@ impl Slave {
                 for (x, (r, u)) in x.iter_mut().zip(reference.iter().zip(u)) {
                     *x = r + sign * epsilon * u;
                 }
-                slabs.internal_force(&x, false, &mut scratch, &mut twice);
+                slabs.internal_force(&x, options.nonlinear_forces, &mut scratch, &mut twice);
             }
             for (f, t) in f.iter_mut().zip(&twice) {
                 *f = t / (2.0 * epsilon * epsilon);

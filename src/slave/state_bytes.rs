@@ -464,15 +464,7 @@ impl Slave {
                 }
                 let since_motion_jump =
                     r.u32("the internal steps since a motion input last jumped")?;
-                let sampled_motion = match r.u8("whether the motion inputs are sampled")? {
-                    0 => false,
-                    1 => true,
-                    b => {
-                        return Err(Error::new(format!(
-                            "the serialized FMU state holds {b} for whether the motion inputs are sampled: not 0 or 1"
-                        )))
-                    }
-                };
+                let sampled_motion = r.boolean("whether the motion inputs are sampled")?;
                 let deformation_scale = r.f64("the deformation scale")?;
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
                 let estimate_floor = r.f64("the estimate floor")?;

@@ -190,11 +190,7 @@ impl Ladder {
                 ..self
             }
         } else {
-            Ladder {
-                since_motion_jump: self.since_motion_jump,
-                sampled_motion: self.sampled_motion,
-                ..Ladder::on(level)
-            }
+            Ladder::on(level)
         }
     }
 

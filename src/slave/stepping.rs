@@ -73,9 +73,15 @@ impl Slave {
         // A probe takes this step on the rung above (step_control, "probes"), if the step
         // there will be estimated (not one internal step after an input jump).
         let mut probing = controlled && ladder.probes();
-        if probing && self.inputs_jumped {
+        if probing && (self.inputs_jumped || self.since_motion_jump < MOTION_RINGING_STEPS) {
+            // Its last internal step must be estimated: not the one after a jump, nor within
+            // a sampled motion's ringing (`MOTION_RINGING_STEPS`).
             probing = match self.internal_steps(big_h, ladder.level - 1) {
-                Ok((n, _)) => n > 1,
+                Ok((n, _)) => {
+                    (n > 1 || !self.inputs_jumped)
+                        && u64::from(self.since_motion_jump) + n as u64
+                            > u64::from(MOTION_RINGING_STEPS)
+                }
                 Err(e) => {
                     return Err(self.roll_back(t_c, communication_step_size, e, &before, false))
                 }
@@ -557,7 +563,7 @@ impl Slave {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled: B3 driven at a 10 ms communication step ends 2.3e-3 of its peak from the converged response at model.accuracy = 1e-3. A shorter communication step reduces it (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
+                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled: B3 driven at a 10 ms communication step ends 2.3e-3 of its peak from the converged response at model.accuracy = 1e-3. A shorter communication step reduces it (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
                 ),
             });
         }

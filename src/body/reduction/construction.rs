@@ -321,11 +321,11 @@ pub(super) fn attachment_modes(
 
 /// The static modal derivatives of the vector modes `vectors[first..]` (the fixed-interface and
 /// attachment modes), appended to `vectors`: for each mode `φ` the second-order static response
-/// `ψ = −K_ii⁻¹ f₂(φ)` with the boundary held, `f₂` the part of the full formulation's internal
-/// force quadratic in the displacement (`second_order_force`). It holds what goes with `φ` at
-/// second order, the axial shortening of a bending shape, which several frames need: each slab
-/// turns with the body's bending, and a basis without it strains the body along its axis when
-/// the slabs turn (docs/formulation.md, "The reduced body": several frames). An unsupported
+/// `ψ = −K_ii⁻¹ f₂(φ)` with the boundary held, `f₂` the part of the slabs' elastic force quadratic
+/// in the displacement (`second_order_force`). It holds what goes with `φ` at second order in
+/// the slab model, the axial shortening of a bending shape: each slab turns with the body's
+/// bending, and a basis without it strains the body along its axis when the slabs turn
+/// (docs/formulation.md, "The reduced body": several frames). An unsupported
 /// body gets none (its solve is shifted; a free body's slabs are not measured).
 pub(super) fn modal_derivatives(
     solve: &mut InteriorSolve,

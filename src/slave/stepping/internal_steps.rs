@@ -98,7 +98,9 @@ impl Slave {
         };
         let controlled = self.error_controlled();
         let jumped = self.inputs_jumped;
-        // Internal steps since a motion input's jump before this call's first.
+        // Internal steps since a motion input's jump before this call's first (within a
+        // communication step counted in this attempt's steps, `hs`, halved on a retry; across
+        // communication steps in the accepted attempt's).
         let since_motion_jump = u64::from(self.since_motion_jump);
         let ringing = |j: usize| {
             let before = (tau0 / hs).round() as u64 + j as u64;
