@@ -239,6 +239,42 @@ impl Patches {
         }
     }
 
+    /// The part of the elastic force at `X + u` quadratic in the displacement `u` (flat, N;
+    /// `reference` the positions `X` of the nodes the slabs cover, `u` and `f` at least as
+    /// long, `f`'s entries beyond them zero): `f(X + u) = K u + f₂(u) + O(u³)`, by central
+    /// differences, `f₂(u) = (f(X + εu) + f(X − εu)) / (2ε²)` (the odd orders cancel), `ε`
+    /// scaling the largest entry of `u` to 1e-3 of `size` (m). With `nonlinear_forces`, `f_nl`'s
+    /// second order too. The modal derivatives of a reduced body with several frames take it
+    /// (docs/formulation.md, "The reduced body"). Allocates (set-up only).
+    pub fn second_order_force(
+        &self,
+        reference: &[f64],
+        u: &[f64],
+        nonlinear_forces: bool,
+        size: f64,
+        f: &mut [f64],
+    ) {
+        let dofs = reference.len();
+        let largest = u[..dofs].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        f.fill(0.0);
+        if largest == 0.0 {
+            return;
+        }
+        let epsilon = 1e-3 * size / largest;
+        let mut scratch = self.scratch();
+        let mut x = reference.to_vec();
+        let mut twice = vec![0.0; dofs];
+        for sign in [1.0, -1.0] {
+            for (x, (r, u)) in x.iter_mut().zip(reference.iter().zip(u)) {
+                *x = r + sign * epsilon * u;
+            }
+            self.internal_force(&x, nonlinear_forces, &mut scratch, &mut twice);
+        }
+        for (f, t) in f.iter_mut().zip(&twice) {
+            *f = t / (2.0 * epsilon * epsilon);
+        }
+    }
+
     /// Adds the elastic force `f_i = Σ_p R_p (g_p,i − w_i X̄_p,i × z_p)` of positions `x` to `f`
     /// (global frame, N; `z_p = 0` without `nonlinear_forces`) and returns the strain energy
     /// `V = Σ_p ½ ū_pᵀ K_p ū_p` (J). No allocation.

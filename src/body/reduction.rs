@@ -68,11 +68,13 @@ use crate::linalg::{dot, SymmetricCsr};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 mod construction;
+mod static_responses;
 use construction::{
-    attachment_modes, barycentric_fields, basis_fields, boundary_coefficients, candidate_fields,
-    constraint_modes, expanded_frame, fixed_interface_modes, held_coordinates, modal_derivatives,
-    reduced_mass, reduced_stiffness, InteriorSolve,
+    barycentric_fields, basis_fields, boundary_coefficients, candidate_fields, constraint_modes,
+    expanded_frame, fixed_interface_modes, held_coordinates, reduced_mass, reduced_stiffness,
+    InteriorSolve,
 };
+use static_responses::{attachment_modes, modal_derivatives};
 
 /// Scalar fields from a vector mode whose mass norm is below this fraction of the mode's
 /// largest component are dropped (round-off of components that vanish by symmetry).

@@ -353,9 +353,8 @@ impl Slave {
         let frame_weights: Vec<f64> = (0..lumped.len())
             .map(|i| if i < mesh_nodes { lumped[i] } else { 0.0 })
             .collect();
-        // Several frames need the basis's second order (`modal_derivatives`): `f₂(u)` of the
-        // slabs' own elastic force (with `f_nl` if it is on), `(f(X + εu) + f(X − εu)) / (2ε²)`
-        // (the odd orders cancel), `ε` scaling `u` to 1e-3 of the body's size.
+        // Several frames need the basis's second order in the slabs' own force
+        // (`modal_derivatives`, `Patches::second_order_force`).
         let slabs = if p.frames > 1 {
             Some(Patches::along_principal_axis(
                 &self.mesh,
@@ -366,29 +365,10 @@ impl Slave {
         } else {
             None
         };
-        let size = self.size;
-        let reference = &matrices.reference;
+        let (size, reference) = (self.size, &matrices.reference[..3 * mesh_nodes]);
         let second_order_force = |u: &[f64], f: &mut [f64]| {
             let slabs = slabs.as_ref().expect("several frames");
-            let dofs = 3 * mesh_nodes;
-            let largest = u[..dofs].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            f.fill(0.0);
-            if largest == 0.0 {
-                return;
-            }
-            let epsilon = 1e-3 * size / largest;
-            let mut scratch = slabs.scratch();
-            let mut x = reference[..dofs].to_vec();
-            let mut twice = vec![0.0; dofs];
-            for sign in [1.0, -1.0] {
-                for (x, (r, u)) in x.iter_mut().zip(reference.iter().zip(u)) {
-                    *x = r + sign * epsilon * u;
-                }
-                slabs.internal_force(&x, options.nonlinear_forces, &mut scratch, &mut twice);
-            }
-            for (f, t) in f.iter_mut().zip(&twice) {
-                *f = t / (2.0 * epsilon * epsilon);
-            }
+            slabs.second_order_force(reference, u, options.nonlinear_forces, size, f);
         };
         let reduction = Reduction::new(
             &MeshData {

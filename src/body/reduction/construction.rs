@@ -1,6 +1,6 @@
 //! The construction of the reduced body's basis, phase by phase (the module documentation of
-//! `reduction` states the basis): interior solves, constraint, fixed-interface and attachment
-//! modes, candidate scalar fields, their coefficients on the boundary sets, the held and free
+//! `reduction` states the basis): interior solves, constraint and fixed-interface modes (the
+//! static responses to loads are in `static_responses`), candidate scalar fields, their coefficients on the boundary sets, the held and free
 //! fields, the reduced mass and stiffness, the frame of the expanded nodes, the held
 //! coordinates.
 
@@ -98,6 +98,29 @@ impl InteriorSolve {
     }
 
     /// A full vector (flat `3N`) with the interior `values` and zero on the boundary.
+    /// The static response `u = K_ii⁻¹ f_i` of the interior to the load `f` (flat `3N`, N), the
+    /// boundary held, expanded to `3N` (m).
+    pub(super) fn static_response(&mut self, load: &[f64]) -> Vec<f64> {
+        let mut rhs: Vec<f64> = self.interior.iter().map(|&dof| load[dof]).collect();
+        self.factor.solve_in_place(&mut rhs, &mut self.workspace);
+        self.expand(&rhs)
+    }
+
+    /// Whether the body has no boundary set (its solve is shifted, with inertia relief).
+    pub(super) fn free_body(&self) -> bool {
+        self.free_body
+    }
+
+    /// `3N`.
+    pub(super) fn dof_count(&self) -> usize {
+        self.n3
+    }
+
+    /// The mass matrix `Ms ⊗ I3` (kg, `3N × 3N`).
+    pub(super) fn mass(&self) -> &SymmetricCsr {
+        &self.m3
+    }
+
     fn expand(&self, values: &[f64]) -> Vec<f64> {
         let mut u = vec![0.0; self.n3];
         for (&dof, v) in self.interior.iter().zip(values) {
@@ -283,66 +306,6 @@ fn truncation_errors(loads: &[(Vec<f64>, Vec<f64>)], modes: &[Vec<f64>], rigid: 
         errors.iter_mut().for_each(|e| *e = (*e / largest).sqrt());
     }
     errors
-}
-
-/// The attachment modes of the force interfaces `loaded` (unit forces and torques distributed
-/// as the interface distributes them; inertia relief for an unsupported body), appended to
-/// `vectors`.
-pub(super) fn attachment_modes(
-    solve: &mut InteriorSolve,
-    reference: &[f64],
-    lumped: &[f64],
-    loaded: &[&NodeSet],
-    vectors: &mut Vec<Vec<f64>>,
-) {
-    // 4. Attachment modes.
-    let rigid_modes = solve
-        .free_body
-        .then(|| RigidModes::new(reference, &solve.m3, lumped));
-    for set in loaded {
-        for j in 0..6 {
-            let unit = Vector3::ith(j % 3, 1.0);
-            let (force, torque) = if j < 3 {
-                (unit, Vector3::zeros())
-            } else {
-                (Vector3::zeros(), unit)
-            };
-            let mut load = vec![0.0; solve.n3];
-            set.distribute(reference, &force, &torque, &mut load);
-            if let Some(r) = &rigid_modes {
-                r.relieve(&mut load);
-            }
-            let mut rhs: Vec<f64> = solve.interior.iter().map(|&dof| load[dof]).collect();
-            solve.factor.solve_in_place(&mut rhs, &mut solve.workspace);
-            vectors.push(solve.expand(&rhs));
-        }
-    }
-}
-
-/// The static modal derivatives of the vector modes `vectors[first..]` (the fixed-interface and
-/// attachment modes), appended to `vectors`: for each mode `φ` the second-order static response
-/// `ψ = −K_ii⁻¹ f₂(φ)` with the boundary held, `f₂` the part of the slabs' elastic force quadratic
-/// in the displacement (`second_order_force`). It holds what goes with `φ` at second order in
-/// the slab model, the axial shortening of a bending shape: each slab turns with the body's
-/// bending, and a basis without it strains the body along its axis when the slabs turn
-/// (docs/formulation.md, "The reduced body": several frames). An unsupported
-/// body gets none (its solve is shifted; a free body's slabs are not measured).
-pub(super) fn modal_derivatives(
-    solve: &mut InteriorSolve,
-    second_order_force: &dyn Fn(&[f64], &mut [f64]),
-    first: usize,
-    vectors: &mut Vec<Vec<f64>>,
-) {
-    if solve.free_body {
-        return;
-    }
-    let mut force = vec![0.0; solve.n3];
-    for k in first..vectors.len() {
-        second_order_force(&vectors[k], &mut force);
-        let mut rhs: Vec<f64> = solve.interior.iter().map(|&dof| -force[dof]).collect();
-        solve.factor.solve_in_place(&mut rhs, &mut solve.workspace);
-        vectors.push(solve.expand(&rhs));
-    }
 }
 
 /// The candidate scalar fields, of unit mass norm: the affine fields, then the components of
