@@ -196,8 +196,6 @@ pub struct Slave {
     step_estimate: f64,
     /// Whether an input jumped at the start of the communication step under way.
     inputs_jumped: bool,
-    /// Whether a motion interface's inputs jumped there.
-    motion_jumped: bool,
     /// Internal steps since a motion input last jumped, at the start of the communication step
     /// under way (`step_control::MOTION_RINGING_STEPS`).
     since_motion_jump: u32,
@@ -304,7 +302,6 @@ impl Slave {
             step_error_unfloored: 0.0,
             step_estimate: 0.0,
             inputs_jumped: false,
-            motion_jumped: false,
             since_motion_jump: 0,
             scale_scratch: Vec::new(),
             events: Vec::new(),

@@ -101,6 +101,13 @@ pub const UNESTIMATED_WARN_AFTER: u32 = 10;
 /// input's does: the body's response to it is what the estimate must follow.
 pub const MOTION_RINGING_STEPS: u32 = 8;
 
+/// Whether an internal step that `steps` internal steps follow since a sampled motion input's
+/// jump (`since_jump` of them before the communication step, [`MOTION_RINGING_STEPS`] once the
+/// motion is not sampled) lies within the jump's ringing, and is not estimated.
+pub fn within_ringing(since_jump: u32, steps: usize) -> bool {
+    u64::from(since_jump) + (steps as u64) < u64::from(MOTION_RINGING_STEPS)
+}
+
 /// Where the internal step stands on the ladder between communication steps (part of the FMU
 /// state).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -340,6 +347,16 @@ mod tests {
             top = top.after_step(Some(0.0));
         }
         assert!(!top.probes());
+    }
+
+    #[test]
+    fn the_ringing_window_holds_the_first_eight_internal_steps() {
+        // After a sampled jump the steps with 0..7 steps before them are in it, the ninth not.
+        assert!(within_ringing(0, 0) && within_ringing(0, MOTION_RINGING_STEPS as usize - 1));
+        assert!(!within_ringing(0, MOTION_RINGING_STEPS as usize));
+        assert!(within_ringing(5, 2) && !within_ringing(5, 3));
+        // A motion that is not sampled starts the count at the window's end.
+        assert!(!within_ringing(MOTION_RINGING_STEPS, 0));
     }
 
     #[test]

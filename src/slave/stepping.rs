@@ -5,8 +5,8 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    finer_level, rung, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS, NOISE_MARGIN,
-    UNESTIMATED_WARN_AFTER,
+    finer_level, rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS,
+    NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
@@ -47,14 +47,15 @@ impl Slave {
         // The driving frames of the last step, put back if this one is rolled back (they tell
         // the next step whether its inputs jump).
         self.driving_before.copy_from_slice(&self.driving);
-        (self.inputs_jumped, self.motion_jumped) = match self.update_driving_frames() {
+        let motion_jumped;
+        (self.inputs_jumped, motion_jumped) = match self.update_driving_frames() {
             Ok(jumped) => jumped,
             Err(e) => {
                 self.driving.copy_from_slice(&self.driving_before);
                 return Err(e);
             }
         };
-        if self.motion_jumped {
+        if motion_jumped {
             // The kink a motion input's jump puts in the held coordinates' path rings for the
             // next internal steps, which are not estimated if the motion is sampled
             // (`MOTION_RINGING_STEPS`).
@@ -70,17 +71,14 @@ impl Slave {
         let before = StepStart::of(self.dynamics.as_ref().unwrap(), self.events.len());
         // Whether the backup holds this step's start (an error before it must not restore it).
         let mut backed_up = false;
-        // A probe takes this step on the rung above (step_control, "probes"), if the step
-        // there will be estimated (not one internal step after an input jump).
+        // A probe takes this step on the rung above (step_control, "probes"), if the step's
+        // last internal step there will be estimated: not the one after an input jump, nor one
+        // within a sampled motion's ringing.
         let mut probing = controlled && ladder.probes();
-        if probing && (self.inputs_jumped || self.since_motion_jump < MOTION_RINGING_STEPS) {
-            // Its last internal step must be estimated: not the one after a jump, nor within
-            // a sampled motion's ringing (`MOTION_RINGING_STEPS`).
+        if probing && (self.inputs_jumped || within_ringing(self.since_motion_jump, 0)) {
             probing = match self.internal_steps(big_h, ladder.level - 1) {
                 Ok((n, _)) => {
-                    (n > 1 || !self.inputs_jumped)
-                        && u64::from(self.since_motion_jump) + n as u64
-                            > u64::from(MOTION_RINGING_STEPS)
+                    (n > 1 || !self.inputs_jumped) && !within_ringing(self.since_motion_jump, n - 1)
                 }
                 Err(e) => {
                     return Err(self.roll_back(t_c, communication_step_size, e, &before, false))

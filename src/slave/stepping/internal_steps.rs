@@ -4,7 +4,7 @@
 
 use super::super::interfaces::{apply_loads, prescribe_motion};
 use super::super::step_control::{
-    allowance, error_ratio, GROW_BELOW, ITERATION_NOISE, MOTION_RINGING_STEPS,
+    allowance, error_ratio, within_ringing, GROW_BELOW, ITERATION_NOISE,
 };
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
@@ -101,11 +101,9 @@ impl Slave {
         // Internal steps since a motion input's jump before this call's first (within a
         // communication step counted in this attempt's steps, `hs`, halved on a retry; across
         // communication steps in the accepted attempt's).
-        let since_motion_jump = u64::from(self.since_motion_jump);
-        let ringing = |j: usize| {
-            let before = (tau0 / hs).round() as u64 + j as u64;
-            since_motion_jump + before < u64::from(MOTION_RINGING_STEPS)
-        };
+        let since_motion_jump = self.since_motion_jump;
+        let ringing =
+            |j: usize| within_ringing(since_motion_jump, (tau0 / hs).round() as usize + j);
         // The allowance of these internal steps, from the deformation scale (updated after
         // each step that is estimated, and at the end of each communication step).
         let horizon = self.error_horizon();
