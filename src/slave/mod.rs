@@ -186,6 +186,9 @@ pub struct Slave {
     /// Whether the body has warned that a step was accepted on the iteration's floor rather than
     /// on `model.accuracy` (`slave::stepping::internal_steps`).
     floor_warned: bool,
+    /// Whether the body has said that the iteration's tolerance follows the allowance of the
+    /// internal steps (`slave::stepping::internal_steps`).
+    tolerance_followed: bool,
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
@@ -298,6 +301,7 @@ impl Slave {
             rejected: 0,
             unestimated: (0, 0, false),
             floor_warned: false,
+            tolerance_followed: false,
             step_error: None,
             step_error_unfloored: 0.0,
             step_estimate: 0.0,
@@ -512,6 +516,7 @@ impl Slave {
         self.rejected = 0;
         self.unestimated = (0, 0, false);
         self.floor_warned = false;
+        self.tolerance_followed = false;
         self.outputs.valid = false;
         self.results = None;
     }

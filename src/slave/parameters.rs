@@ -83,7 +83,8 @@ impl Parameters {
     /// The iteration's relative tolerance (× size): `solver.tolerance`, or with the time error
     /// control on the smaller [`TOLERANCE_PER_ACCURACY`] × `model.accuracy`, not below
     /// [`TOLERANCE_FLOOR`] (docs/formulation.md, "Time error control": the iteration's
-    /// tolerance). At the default accuracy 1e-2 both are 1e-10.
+    /// tolerance). At the default accuracy 1e-2 both are 1e-10. The internal steps may follow
+    /// their allowance below it (`Slave::following_tolerance`).
     pub(super) fn iteration_tolerance(&self) -> f64 {
         if self.accuracy > 0.0 && self.integrator == Integrator::GeneralizedAlpha {
             self.tolerance

@@ -54,6 +54,16 @@
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
 pub const ITERATION_NOISE: f64 = 10.0;
 
+/// The iteration's tolerance follows the allowance of the internal steps where the floor would
+/// pass their errors ([`ITERATION_NOISE`] × tolerance × size above the allowance), once the first
+/// period has passed, and only for a deformation whose whole budget `ε D` is at least this many
+/// of the iteration's own tolerances `tolerance × size`: below, the deformation is at the
+/// iteration's resolution and the floor stands (docs/formulation.md, "Time error control": the
+/// iteration's tolerance). B2 at `ε = 1e-3`: `ε D` is 1.8e5 of them, and it follows; a nearly
+/// rigid pendulum (`D` 1e-8 of its size at `ε = 1e-2`): 1, and following its allowance down to
+/// round-off refined it to 4 µs for its whole swing.
+pub const FOLLOW_ABOVE: f64 = 1e3;
+
 /// An estimate that refining did not reduce becomes a floor of the allowance with this margin,
 /// so that the rung it came from is judged within its allowance.
 pub const NOISE_MARGIN: f64 = 4.0;

@@ -3,8 +3,9 @@
 //! for one (docs/formulation.md, "Time error control").
 
 use super::super::interfaces::{apply_loads, prescribe_motion};
+use super::super::parameters::TOLERANCE_FLOOR;
 use super::super::step_control::{
-    allowance, error_ratio, within_ringing, GROW_BELOW, ITERATION_NOISE,
+    allowance, error_ratio, within_ringing, FOLLOW_ABOVE, GROW_BELOW, ITERATION_NOISE,
 };
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
@@ -90,13 +91,27 @@ impl Slave {
         m: usize,
         last_of_step: bool,
     ) -> Result<()> {
-        let floor = self.parameters.iteration_tolerance() * self.size;
+        let controlled = self.error_controlled();
+        let horizon = self.error_horizon();
+        let accuracy = self.parameters.accuracy;
+        let own_tolerance = self.parameters.iteration_tolerance();
+        let tolerance = self.following_tolerance(hs).unwrap_or(own_tolerance);
+        let floor = tolerance * self.size;
+        if tolerance < own_tolerance && !self.tolerance_followed {
+            self.tolerance_followed = true;
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "the iteration's tolerance follows model.accuracy from t = {:.6}: {tolerance:.3e} × size with internal steps of {hs:e} s, below the accuracy's own {own_tolerance:e}, whose floor {ITERATION_NOISE} × tolerance × size would pass their errors (the tolerance goes with the allowance of each internal step)",
+                    t0 + tau0
+                ),
+            });
+        }
         let mut settings = IterationSettings {
             absolute_tolerance: floor,
             max_iterations: self.parameters.max_iterations.max(1) as usize,
             estimate_error: None,
         };
-        let controlled = self.error_controlled();
         let jumped = self.inputs_jumped;
         // Internal steps since a motion input's jump before this call's first (within a
         // communication step counted in this attempt's steps, `hs`, halved on a retry; across
@@ -106,8 +121,6 @@ impl Slave {
             |j: usize| within_ringing(since_motion_jump, (tau0 / hs).round() as usize + j);
         // The allowance of these internal steps, from the deformation scale (updated after
         // each step that is estimated, and at the end of each communication step).
-        let horizon = self.error_horizon();
-        let accuracy = self.parameters.accuracy;
         let noise = (ITERATION_NOISE * floor).max(self.dynamics.as_ref().unwrap().estimate_floor);
         let allowed = |scale: f64| match (controlled, horizon) {
             (true, Some(horizon)) => allowance(accuracy, scale, hs, horizon, noise),
@@ -221,10 +234,10 @@ impl Slave {
                 let unfloored = ratio_above(dynamics.estimate_floor);
                 self.step_error_unfloored = self.step_error_unfloored.max(unfloored);
                 let judged_on_floor = ratio <= 1.0 && unfloored > 1.0;
-                // The iteration's tolerance, not the accuracy, passed this step
-                // (docs/formulation.md, "Time error control": the iteration's tolerance). In
-                // the first period the deformation scale is still building up from 0, and a
-                // floor there is the one it needs.
+                // The iteration's tolerance, not the accuracy, passed this step even at the
+                // round-off's tolerance (docs/formulation.md, "Time error control": the
+                // iteration's tolerance). In the first period the deformation scale is still
+                // building up from 0, and a floor there is the one it needs.
                 if judged_on_floor
                     && !self.floor_warned
                     && dynamics.estimate_floor < ITERATION_NOISE * floor
@@ -234,11 +247,14 @@ impl Slave {
                     self.events.push(LogEvent {
                         category: category::EVENTS,
                         message: format!(
-                            "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {accuracy_allows:.3e} m: below the iteration's tolerance ({:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on",
+                            "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {accuracy_allows:.3e} m: {}",
                             dynamics.state.time,
                             ITERATION_NOISE * floor,
-                            floor / self.size,
-                            accuracy_allows / (2.0 * ITERATION_NOISE * self.size),
+                            if tolerance <= TOLERANCE_FLOOR {
+                                format!("the iteration's tolerance is at the round-off's {TOLERANCE_FLOOR:e} (× size), below which the time error is not controlled")
+                            } else {
+                                format!("below the iteration's tolerance ({tolerance:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on", accuracy_allows / (2.0 * ITERATION_NOISE * self.size))
+                            }
                         ),
                     });
                 }
@@ -247,6 +263,40 @@ impl Slave {
             }
         }
         Ok(())
+    }
+}
+
+impl Slave {
+    /// The iteration's relative tolerance (× size) where it follows the allowance of internal
+    /// steps of `hs` (s): `allowance / (2 × ITERATION_NOISE × size)`, not below
+    /// [`TOLERANCE_FLOOR`], where that is below the accuracy's own
+    /// ([`Parameters::iteration_tolerance`](super::super::parameters::Parameters::iteration_tolerance)),
+    /// once the first period of the lowest mode has passed (docs/formulation.md, "Time error
+    /// control": the iteration's tolerance). `None`: the accuracy's own tolerance holds (no
+    /// error control, the first period, or an allowance above its floor).
+    fn following_tolerance(&self, hs: f64) -> Option<f64> {
+        let modes = self.model.as_ref()?.lowest_modes.as_ref()?;
+        let dynamics = self.dynamics.as_ref()?;
+        let horizon = self.error_horizon()?;
+        if !self.error_controlled() || dynamics.state.time - self.start_time <= modes.first_period()
+        {
+            return None;
+        }
+        // A deformation within `FOLLOW_ABOVE` of the iteration's own tolerances is at its
+        // resolution: the floor stands (a nearly rigid pendulum, `D` 1e-8 of its size).
+        let own = self.parameters.iteration_tolerance();
+        if self.parameters.accuracy * dynamics.deformation_scale < FOLLOW_ABOVE * own * self.size {
+            return None;
+        }
+        let allows = allowance(
+            self.parameters.accuracy,
+            dynamics.deformation_scale,
+            hs,
+            horizon,
+            0.0,
+        );
+        let tolerance = (allows / (2.0 * ITERATION_NOISE * self.size)).max(TOLERANCE_FLOOR);
+        (tolerance < own).then_some(tolerance)
     }
 }
 
