@@ -506,12 +506,16 @@ fn the_iterations_tolerance_follows_the_allowance() {
         let mut said = Vec::new();
         let mut history = Vec::new();
         let mut saved = None;
+        let mut tail = Vec::new();
         for k in 0..(end / H).round() as usize {
             if save_at == Some(k) {
                 saved = Some(s.get_state());
             }
             s.do_step(k as f64 * H, H).unwrap();
             history.push(s.get_real(tip).unwrap() - y0);
+            if save_at.is_some_and(|at| k >= at) {
+                tail.push(s.get_real(tip).unwrap());
+            }
             said.extend(
                 s.drain_events()
                     .filter(|e| {
@@ -521,17 +525,22 @@ fn the_iterations_tolerance_follows_the_allowance() {
                     .map(|e| e.message),
             );
         }
-        (history, said, s, saved)
+        (history, said, s, saved, tail)
     };
     let (reference, ..) = run(&[("model.accuracy", 0.0), ("solver.stepSize", 5e-6)], None);
     let peak = peak(&reference);
     let steps = (end / H).round() as usize;
-    let (controlled, said, mut s, saved) = run(&[("model.accuracy", 1e-3)], Some(steps - 5));
+    let (controlled, said, mut s, saved, tail) = run(&[("model.accuracy", 1e-3)], Some(steps - 5));
     println!("{said:?}");
     assert_eq!(
         said.len(),
         1,
         "said once, and no step on the floor: {said:?}"
+    );
+    assert!(
+        said[0].contains("the iteration's tolerance follows"),
+        "{}",
+        said[0]
     );
     let tolerance: f64 = said[0]
         .split(": ")
@@ -548,8 +557,8 @@ fn the_iterations_tolerance_follows_the_allowance() {
     let from_start_error = largest_difference(&from_start, &reference) / peak;
     println!("following {error:.3e} of the peak, tight from the start {from_start_error:.3e}");
     assert!(error <= 2.0 * from_start_error, "{error:.3e}");
-    // The last 5 steps replayed from the state saved before them, through the byte form into a
-    // fresh instance, give the same bits.
+    // The last 5 steps replayed from the state saved before them, in the instance and through
+    // the byte form into a fresh one, give the run's bits.
     let tip = vr(&s, "tip.position[2]");
     let replay = |s: &mut Slave| {
         (steps - 5..steps)
@@ -562,6 +571,7 @@ fn the_iterations_tolerance_follows_the_allowance() {
     let saved = saved.unwrap();
     s.set_state(&saved).unwrap();
     let first = replay(&mut s);
+    assert_eq!(first, tail, "the replay is the run");
     let bytes = {
         let mut b = Vec::new();
         flexbody::slave::CoSimSlave::state_to_bytes(&s, &saved, &mut b);

@@ -561,7 +561,7 @@ impl Slave {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled: B3 driven at a 10 ms communication step ends 2.3e-3 of its peak from the converged response at model.accuracy = 1e-3. A shorter communication step reduces it (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
+                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled: B3 driven at a 10 ms communication step ends 2.3e-3 of its peak from the converged response at model.accuracy = 1e-3. A shorter communication step reduces it, and so does solver.stepSize below the communication step, whose internal steps it then fixes (B3 with solver.stepSize = 5e-3: 6.9e-4; docs/formulation.md, \"Time error control\"); the run summary counts these steps"
                 ),
             });
         }

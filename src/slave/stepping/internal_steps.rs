@@ -42,7 +42,7 @@ impl Slave {
                     .get_or_insert_with(|| state.clone())
                     .copy_from(state);
             }
-            let result = self.advance(t0, big_h, tau0, hs, m, i + 1 == n);
+            let result = self.advance(t0, big_h, tau0, (h, hs), m, i + 1 == n);
             let e = match result {
                 Ok(()) => return Ok(()),
                 Err(e) => e,
@@ -87,7 +87,7 @@ impl Slave {
         t0: f64,
         big_h: f64,
         tau0: f64,
-        hs: f64,
+        (rung, hs): (f64, f64),
         m: usize,
         last_of_step: bool,
     ) -> Result<()> {
@@ -95,7 +95,13 @@ impl Slave {
         let horizon = self.error_horizon();
         let accuracy = self.parameters.accuracy;
         let own_tolerance = self.parameters.iteration_tolerance();
-        let tolerance = self.following_tolerance(hs).unwrap_or(own_tolerance);
+        // Past the first period (while the deformation scale still grows from 0, the floor is
+        // what the control needs), at the start of these internal steps: one test for the
+        // following tolerance and the floor's warning.
+        let after_first_period = self.after_first_period();
+        // The rung's tolerance, also for a retry in smaller steps (a retry is for an iteration
+        // that did not converge, which a tighter tolerance would not help).
+        let tolerance = self.following_tolerance(rung).unwrap_or(own_tolerance);
         let floor = tolerance * self.size;
         if tolerance < own_tolerance && !self.tolerance_followed {
             self.tolerance_followed = true;
@@ -241,7 +247,7 @@ impl Slave {
                 if judged_on_floor
                     && !self.floor_warned
                     && dynamics.estimate_floor < ITERATION_NOISE * floor
-                    && dynamics.state.time - self.start_time > modes.first_period()
+                    && after_first_period
                 {
                     self.floor_warned = true;
                     self.events.push(LogEvent {
@@ -251,7 +257,7 @@ impl Slave {
                             dynamics.state.time,
                             ITERATION_NOISE * floor,
                             if tolerance <= TOLERANCE_FLOOR {
-                                format!("the iteration's tolerance is at the round-off's {TOLERANCE_FLOOR:e} (× size), below which the time error is not controlled")
+                                format!("the iteration's tolerance is at the round-off's {tolerance:e} (× size), below which the time error is not controlled")
                             } else {
                                 format!("below the iteration's tolerance ({tolerance:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on", accuracy_allows / (2.0 * ITERATION_NOISE * self.size))
                             }
@@ -275,11 +281,9 @@ impl Slave {
     /// control": the iteration's tolerance). `None`: the accuracy's own tolerance holds (no
     /// error control, the first period, or an allowance above its floor).
     fn following_tolerance(&self, hs: f64) -> Option<f64> {
-        let modes = self.model.as_ref()?.lowest_modes.as_ref()?;
         let dynamics = self.dynamics.as_ref()?;
         let horizon = self.error_horizon()?;
-        if !self.error_controlled() || dynamics.state.time - self.start_time <= modes.first_period()
-        {
+        if !self.error_controlled() || !self.after_first_period() {
             return None;
         }
         // A deformation within `FOLLOW_ABOVE` of the iteration's own tolerances is at its
@@ -297,6 +301,21 @@ impl Slave {
         );
         let tolerance = (allows / (2.0 * ITERATION_NOISE * self.size)).max(TOLERANCE_FLOOR);
         (tolerance < own).then_some(tolerance)
+    }
+
+    /// Whether the body's time is past the first period `T₁` of its lowest mode since the start
+    /// (with the error control; docs/formulation.md, "Time error control": the iteration's
+    /// tolerance).
+    fn after_first_period(&self) -> bool {
+        match (
+            self.model.as_ref().and_then(|m| m.lowest_modes.as_ref()),
+            self.dynamics.as_ref(),
+        ) {
+            (Some(modes), Some(dynamics)) => {
+                dynamics.state.time - self.start_time > modes.first_period()
+            }
+            _ => false,
+        }
     }
 }
 
