@@ -101,7 +101,10 @@ impl Slave {
         let after_first_period = self.after_first_period();
         // The rung's tolerance, also for a retry in smaller steps (a retry is for an iteration
         // that did not converge, which a tighter tolerance would not help).
-        let tolerance = self.following_tolerance(rung).unwrap_or(own_tolerance);
+        let tolerance = after_first_period
+            .then(|| self.following_tolerance(rung))
+            .flatten()
+            .unwrap_or(own_tolerance);
         let floor = tolerance * self.size;
         if tolerance < own_tolerance && !self.tolerance_followed {
             self.tolerance_followed = true;
@@ -276,14 +279,14 @@ impl Slave {
     /// The iteration's relative tolerance (× size) where it follows the allowance of internal
     /// steps of `hs` (s): `allowance / (2 × ITERATION_NOISE × size)`, not below
     /// [`TOLERANCE_FLOOR`], where that is below the accuracy's own
-    /// ([`Parameters::iteration_tolerance`](super::super::parameters::Parameters::iteration_tolerance)),
-    /// once the first period of the lowest mode has passed (docs/formulation.md, "Time error
-    /// control": the iteration's tolerance). `None`: the accuracy's own tolerance holds (no
-    /// error control, the first period, or an allowance above its floor).
+    /// ([`Parameters::iteration_tolerance`](super::super::parameters::Parameters::iteration_tolerance));
+    /// taken once the first period of the lowest mode has passed (docs/formulation.md, "Time
+    /// error control": the iteration's tolerance). `None`: the accuracy's own tolerance holds
+    /// (no error control, or an allowance above its floor).
     fn following_tolerance(&self, hs: f64) -> Option<f64> {
         let dynamics = self.dynamics.as_ref()?;
         let horizon = self.error_horizon()?;
-        if !self.error_controlled() || !self.after_first_period() {
+        if !self.error_controlled() {
             return None;
         }
         // A deformation within `FOLLOW_ABOVE` of the iteration's own tolerances is at its
