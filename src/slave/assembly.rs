@@ -366,10 +366,11 @@ impl Slave {
             None
         };
         let (size, reference) = (self.size, &matrices.reference[..3 * mesh_nodes]);
-        let second_order_force = |u: &[f64], f: &mut [f64]| {
-            let slabs = slabs.as_ref().expect("several frames");
-            slabs.second_order_force(reference, u, options.nonlinear_forces, size, f);
-        };
+        let second_order_force = slabs.as_ref().map(|slabs| {
+            move |u: &[f64], f: &mut [f64]| {
+                slabs.second_order_force(reference, u, options.nonlinear_forces, size, f)
+            }
+        });
         let reduction = Reduction::new(
             &MeshData {
                 reference: &matrices.reference,
@@ -378,9 +379,9 @@ impl Slave {
                 force_stiffness: matrices.force_stiffness.as_ref(),
                 lumped,
                 frame_weights: &frame_weights,
-                second_order_force: slabs
-                    .is_some()
-                    .then_some(&second_order_force as &SecondOrderForce<'_>),
+                second_order_force: second_order_force
+                    .as_ref()
+                    .map(|f| f as &SecondOrderForce<'_>),
             },
             &InterfaceSets {
                 held: &sets(true, false),
@@ -464,16 +465,10 @@ impl Slave {
             }
         }
         let mut body = Body::reduced(reduction, options);
-        if p.frames > 1 {
+        if let Some(slabs) = slabs {
             // Several co-moving frames act on the expanded nodes (docs/formulation.md, "The
-            // reduced body").
-            let mesh_lumped = &lumped[..self.mesh.node_count()];
-            body = body.with_patches(Patches::along_principal_axis(
-                &self.mesh,
-                &p.material,
-                mesh_lumped,
-                p.frames as usize,
-            )?);
+            // reduced body"): the slabs the basis took its modal derivatives from.
+            body = body.with_patches(slabs);
         }
         Ok((body, clamped, stiffening))
     }

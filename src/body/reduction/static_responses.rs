@@ -3,7 +3,7 @@
 //! derivatives of the modes, the basis's second order in the slabs' own force.
 
 use super::construction::InteriorSolve;
-use super::RigidModes;
+use super::{RigidModes, SecondOrderForce};
 use crate::body::NodeSet;
 use nalgebra::Vector3;
 
@@ -49,7 +49,7 @@ pub(super) fn attachment_modes(
 /// body gets none (its solve is shifted; a free body's slabs are not measured).
 pub(super) fn modal_derivatives(
     solve: &mut InteriorSolve,
-    second_order_force: &dyn Fn(&[f64], &mut [f64]),
+    second_order_force: &SecondOrderForce<'_>,
     first: usize,
     vectors: &mut Vec<Vec<f64>>,
 ) {
