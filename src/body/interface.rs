@@ -265,13 +265,19 @@ impl NodeSet {
 }
 
 /// A driving frame given by a motion interface's inputs at the start of a communication step:
-/// origin `p`, rotation `Q`, velocity `v` and angular velocity `ω` (global). Over the step it is
-/// extrapolated with constant velocities: `p(τ) = p + v τ`, `Q(τ) = exp([ω τ]×) Q`.
+/// origin `p`, rotation `Q`, velocity `v` and angular velocity `ω` (global).
 ///
 /// Its velocities change only where the inputs do: `acceleration` and `angular_acceleration`
 /// are their mean rates over the time between the last two changes, `(v_k − v_{k−1}) / Δt`
 /// (m/s², rad/s²; zero before the second), and `changed_at` (s) the time of the last change:
 /// the driving motion's accelerations as a reduced body's stiffening takes them.
+///
+/// Over a step it is extrapolated with constant velocities, `p(τ) = p + v τ`,
+/// `Q(τ) = exp([ω τ]×) Q`, unless its velocities are samples of a smooth motion (they changed at
+/// this update and at one shortly before it, and the pose given lies on the path of their mean
+/// rate: `rate_span = Δt > 0`, docs/fmu.md, "Inputs are samples in time"). It is then extrapolated with those rates too (`a`, `α`):
+/// `p(τ) = p + v τ + a τ²/2`, `Q(τ) = exp([ω τ + α τ²/2]×) Q`, `v(τ) = v + a τ`,
+/// `ω(τ) = ω + α τ` (exact for `α ∥ ω`, to `O(τ³)` otherwise).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrivingFrame {
     pub position: Vector3<f64>,
@@ -281,6 +287,9 @@ pub struct DrivingFrame {
     pub acceleration: Vector3<f64>,
     pub angular_acceleration: Vector3<f64>,
     pub changed_at: f64,
+    /// The time between the two changes the rates come from when the frame is extrapolated
+    /// with them (s); zero when it is extrapolated with constant velocities.
+    pub rate_span: f64,
 }
 
 impl Default for DrivingFrame {
@@ -293,18 +302,56 @@ impl Default for DrivingFrame {
             acceleration: Vector3::zeros(),
             angular_acceleration: Vector3::zeros(),
             changed_at: 0.0,
+            rate_span: 0.0,
         }
     }
 }
 
 impl DrivingFrame {
-    /// Origin and rotation `τ` seconds after the inputs were given.
+    /// The rates the frame is extrapolated with: `(a, α)` when its velocities are samples of a
+    /// smooth motion (`rate_span > 0`), zero otherwise.
+    pub fn extrapolation_rates(&self) -> (Vector3<f64>, Vector3<f64>) {
+        if self.rate_span > 0.0 {
+            (self.acceleration, self.angular_acceleration)
+        } else {
+            (Vector3::zeros(), Vector3::zeros())
+        }
+    }
+
+    /// The rotation vector of the turn over `τ`: `ω τ + α τ²/2`.
+    pub fn turn(&self, tau: f64) -> Vector3<f64> {
+        let (_, alpha) = self.extrapolation_rates();
+        self.angular_velocity * tau + alpha * (0.5 * tau * tau)
+    }
+
+    /// Origin and rotation `τ` seconds after the step's start.
     pub fn at(&self, tau: f64) -> (Vector3<f64>, Matrix3<f64>) {
-        let turn = nalgebra::Rotation3::from_scaled_axis(self.angular_velocity * tau);
+        let (a, _) = self.extrapolation_rates();
+        let turn = nalgebra::Rotation3::from_scaled_axis(self.turn(tau));
         (
-            self.position + self.velocity * tau,
+            self.position + self.velocity * tau + a * (0.5 * tau * tau),
             turn.matrix() * self.rotation,
         )
+    }
+
+    /// Velocity and angular velocity `τ` seconds after the step's start.
+    pub fn velocities_at(&self, tau: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let (a, alpha) = self.extrapolation_rates();
+        (self.velocity + a * tau, self.angular_velocity + alpha * tau)
+    }
+
+    /// The same motion `τ` seconds later: the frame a step of `τ` leaves to the next one when
+    /// the inputs are not set again.
+    pub fn advanced(&self, tau: f64) -> DrivingFrame {
+        let (position, rotation) = self.at(tau);
+        let (velocity, angular_velocity) = self.velocities_at(tau);
+        DrivingFrame {
+            position,
+            rotation,
+            velocity,
+            angular_velocity,
+            ..*self
+        }
     }
 }
 
@@ -329,7 +376,8 @@ impl NodeSet {
     }
 
     /// Clamps the nodes to `frame` at `τ`: `x_i = p(τ) + Q(τ)(X_i − X_ref)`,
-    /// `ẋ_i = v + ω × (x_i − p)`, `ẍ_i = ω × (ω × (x_i − p))` (X_ref: the reference point).
+    /// `ẋ_i = v(τ) + ω(τ) × r_i`, `ẍ_i = a + α × r_i + ω(τ) × (ω(τ) × r_i)` with
+    /// `r_i = x_i − p(τ)` (X_ref: the reference point; `a`, `α` the frame's extrapolation rates).
     pub fn prescribe(
         &self,
         reference: &[f64],
@@ -340,17 +388,18 @@ impl NodeSet {
         a: &mut [f64],
     ) {
         let (p, q) = frame.at(tau);
-        let w = frame.angular_velocity;
+        let (velocity, w) = frame.velocities_at(tau);
+        let (acceleration, alpha) = frame.extrapolation_rates();
         self.for_each_held(reference, |index, offset, point| {
             let r = q * offset;
-            let (x0, v0) = if point {
-                (p, frame.velocity)
+            let (x0, v0, a0) = if point {
+                (p, velocity, acceleration)
             } else {
-                (Vector3::zeros(), Vector3::zeros())
+                (Vector3::zeros(), Vector3::zeros(), Vector3::zeros())
             };
             set_node(x, index, &(x0 + r));
             set_node(v, index, &(v0 + w.cross(&r)));
-            set_node(a, index, &w.cross(&w.cross(&r)));
+            set_node(a, index, &(a0 + alpha.cross(&r) + w.cross(&w.cross(&r))));
         });
     }
 }
@@ -446,6 +495,46 @@ fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64>
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A frame following its rates is a quadratic path: carried on by `τ₁` and then `τ₂` it is
+    /// where it is carried on by `τ₁ + τ₂` (turning about one axis), and carried back by the
+    /// time since its inputs were given it is those inputs again.
+    #[test]
+    fn a_frame_following_its_rates_carries_on_as_one_path() {
+        let axis = Vector3::new(0.3, -0.5, 0.8).normalize();
+        let given = DrivingFrame {
+            position: Vector3::new(1.0, 2.0, -0.5),
+            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
+            velocity: Vector3::new(0.5, -1.0, 2.0),
+            angular_velocity: 1.5 * axis,
+            acceleration: Vector3::new(3.0, 1.0, -2.0),
+            angular_acceleration: -4.0 * axis,
+            changed_at: 0.0,
+            rate_span: 0.01,
+        };
+        let (a, b) = (given.advanced(0.013).advanced(0.021), given.advanced(0.034));
+        assert!((a.position - b.position).amax() < 1e-14);
+        assert!((a.rotation - b.rotation).amax() < 1e-14);
+        assert!((a.velocity - b.velocity).amax() < 1e-14);
+        assert!((a.angular_velocity - b.angular_velocity).amax() < 1e-14);
+        let back = b.advanced(-0.034);
+        assert!((back.position - given.position).amax() < 1e-14);
+        assert!((back.rotation - given.rotation).amax() < 1e-14);
+        assert!((back.velocity - given.velocity).amax() < 1e-14);
+        // p + v τ + a τ²/2 and ω + α τ.
+        let tau = 0.034;
+        let p = given.position + given.velocity * tau + given.acceleration * (0.5 * tau * tau);
+        assert!((b.position - p).amax() < 1e-14);
+        assert!((b.angular_velocity - (1.5 - 4.0 * tau) * axis).amax() < 1e-14);
+        // Without a span, constant velocities.
+        let held = DrivingFrame {
+            rate_span: 0.0,
+            ..given
+        }
+        .advanced(tau);
+        assert!((held.position - (given.position + given.velocity * tau)).amax() < 1e-14);
+        assert_eq!(held.velocity, given.velocity);
+    }
 
     fn face() -> (Vec<f64>, NodeSet) {
         // 3×3 grid of nodes in the plane x = 1 with unequal weights

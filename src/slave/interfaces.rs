@@ -215,6 +215,46 @@ pub(super) fn apply_loads(
     }
 }
 
+/// A motion interface's velocities count as samples of a smooth motion, and its frame is
+/// extrapolated with their rates ([`DrivingFrame`]), when they change again within this many
+/// of the last communication step (4 steps, and a half for rounding: an importer that sets the
+/// motion at every update, or at every other as OMSimulator does now and then) and the pose
+/// given with them lies on the smooth path rather than the held one ([`follows_rates`]). A
+/// change after a longer calm stretch is a step of the velocity, held from there (docs/fmu.md,
+/// "Inputs are samples in time").
+pub const RATES_WITHIN: f64 = 4.5;
+
+/// Whether the pose `new` given `since` seconds after the inputs `given` shows the velocities as
+/// samples of a smooth motion: it lies nearer the path with the mean rates of the velocities
+/// between the two (`new`'s accelerations; the velocities' mean, `p + (v + v_new) Δt / 2`) than the
+/// path held at `given`'s velocities, `p + v Δt`, which a master that gives secant velocities
+/// (`(p_{k+1} − p_k) / Δt`, docs/coupling.md) hits exactly. Distances add the origin's and
+/// `size` times the turn between the rotations.
+fn follows_rates(given: &DrivingFrame, new: &DrivingFrame, since: f64, size: f64) -> bool {
+    let from = DrivingFrame {
+        rate_span: 0.0,
+        ..*given
+    };
+    let held = from.advanced(since);
+    let smooth = DrivingFrame {
+        acceleration: new.acceleration,
+        angular_acceleration: new.angular_acceleration,
+        rate_span: since,
+        ..from
+    }
+    .advanced(since);
+    let distance = |a: &DrivingFrame| {
+        let m = new.rotation * a.rotation.transpose();
+        let turn = Vector3::new(
+            m[(2, 1)] - m[(1, 2)],
+            m[(0, 2)] - m[(2, 0)],
+            m[(1, 0)] - m[(0, 1)],
+        );
+        (new.position - a.position).norm() + 0.5 * size * turn.norm()
+    };
+    distance(&smooth) < distance(&held)
+}
+
 /// Whether two driving frames differ beyond round-off (`1e-12` of the quantity, plus `1e-12`
 /// absolute).
 fn frames_differ(a: &DrivingFrame, b: &DrivingFrame) -> bool {
@@ -283,38 +323,40 @@ impl Slave {
             self.input_ages[k] = age;
             match interface.kind {
                 InterfaceKind::Motion => {
+                    let old = self.driving[k];
+                    let carried = old.advanced(last);
+                    if age != 0.0 && last > 0.0 {
+                        // Not set since the last step began: the motion carries on.
+                        self.driving[k] = carried;
+                        continue;
+                    }
                     let mut frame =
                         driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
                     if age != 0.0 {
                         (frame.position, frame.rotation) = frame.at(age);
                     }
-                    let old = self.driving[k];
-                    let (position, rotation) = old.at(last);
-                    let carried = DrivingFrame {
-                        position,
-                        rotation,
-                        ..old
-                    };
-                    let changed = last > 0.0 && frames_differ(&carried, &frame);
-                    jumped |= changed;
-                    motion_jumped |= changed;
-                    // The velocities' mean rates since their last change (`DrivingFrame`).
+                    if last > 0.0 && !frames_differ(&carried, &frame) {
+                        // Set again to where the motion had carried on to.
+                        self.driving[k] = carried;
+                        continue;
+                    }
+                    jumped |= last > 0.0;
+                    motion_jumped |= last > 0.0;
+                    // The velocities' mean rates since their last change (`DrivingFrame`),
+                    // from the inputs given then (the old frame carried on from them).
                     let since = t - old.changed_at;
-                    (
-                        frame.acceleration,
-                        frame.angular_acceleration,
-                        frame.changed_at,
-                    ) = if changed && since > 0.0 {
-                        (
-                            (frame.velocity - old.velocity) / since,
-                            (frame.angular_velocity - old.angular_velocity) / since,
-                            t,
-                        )
-                    } else if last > 0.0 {
-                        (old.acceleration, old.angular_acceleration, old.changed_at)
-                    } else {
-                        (Vector3::zeros(), Vector3::zeros(), t)
-                    };
+                    if last > 0.0 && since > 0.0 {
+                        let given = old.advanced(old.changed_at - (t - last));
+                        frame.acceleration = (frame.velocity - given.velocity) / since;
+                        frame.angular_acceleration =
+                            (frame.angular_velocity - given.angular_velocity) / since;
+                        if since <= RATES_WITHIN * last
+                            && follows_rates(&given, &frame, since, self.size)
+                        {
+                            frame.rate_span = since;
+                        }
+                    }
+                    frame.changed_at = t;
                     self.driving[k] = frame;
                 }
                 InterfaceKind::Force if age == 0.0 => {
@@ -342,8 +384,9 @@ impl Slave {
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or
     /// a derivative) is set. Inputs set at time `t_s` describe the interface at `t_s`; those
     /// not set again continue along their extrapolation, so they are moved to the current time
-    /// `t` (`τ = t − t_s`): a motion interface's pose with its velocities (`p + v τ`,
-    /// `exp([ω]× τ) Q`), a force interface's force and torque with their derivatives
+    /// `t` (`τ = t − t_s`): a motion interface's pose and velocities as its driving frame
+    /// carries them on ([`DrivingFrame::advanced`]: `p + v τ`, `exp([ω τ]×) Q`, or with the
+    /// frame's rates when its velocities are samples of a smooth motion), a force interface's force and torque with their derivatives
     /// (`u + u'τ + u''τ²/2`, `u' + u''τ`). Before initialization the inputs describe the start
     /// time. Allocation-free.
     pub(super) fn resample_inputs(&mut self, k: usize) {
@@ -361,18 +404,24 @@ impl Slave {
                     Vector3::from_column_slice(&input[slot(q)..slot(q) + 3])
                 };
                 let r = slot(InterfaceQuantity::Rotation);
+                // The inputs carry on as the driving frame made from them does, with its rates.
                 let frame = DrivingFrame {
                     position: vector(input, InterfaceQuantity::Position),
                     rotation: Matrix3::from_row_slice(&input[r..r + 9]),
                     velocity: vector(input, InterfaceQuantity::Velocity),
                     angular_velocity: vector(input, InterfaceQuantity::AngularVelocity),
-                    ..DrivingFrame::default()
-                };
-                let (p, q) = frame.at(tau);
-                let at = slot(InterfaceQuantity::Position);
-                input[at..at + 3].copy_from_slice(p.as_slice());
+                    ..self.driving[k]
+                }
+                .advanced(tau);
+                for (quantity, value) in [
+                    (InterfaceQuantity::Position, frame.position),
+                    (InterfaceQuantity::Velocity, frame.velocity),
+                    (InterfaceQuantity::AngularVelocity, frame.angular_velocity),
+                ] {
+                    input[slot(quantity)..slot(quantity) + 3].copy_from_slice(value.as_slice());
+                }
                 for (j, value) in input[r..r + 9].iter_mut().enumerate() {
-                    *value = q[(j / 3, j % 3)];
+                    *value = frame.rotation[(j / 3, j % 3)];
                 }
             }
             InterfaceKind::Force => {

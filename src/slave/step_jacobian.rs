@@ -436,13 +436,23 @@ impl Slave {
                 self.driving[interface],
                 quantity,
                 component,
+                // The rates a frame is extrapolated with come from the velocities given at its
+                // change (`DrivingFrame`): `∂a/∂v = 1 / rate_span` when that is now.
+                if self.driving[interface].rate_span > 0.0
+                    && self.driving[interface].changed_at == start
+                {
+                    1.0 / self.driving[interface].rate_span
+                } else {
+                    0.0
+                },
             )),
             Seed::Load { .. } => None,
         };
         let reference = &body.reference;
         let prescribe = |tau: f64, ds: &mut DynamicState| {
-            if let Some((set, frame, quantity, component)) = driven {
-                frame_perturbation(set, reference, &frame, quantity, component, tau, ds);
+            if let Some((set, frame, quantity, component, rate)) = driven {
+                let seed = (quantity, component, rate);
+                frame_perturbation(set, reference, &frame, seed, tau, ds);
             }
         };
         // The residual's directional derivative at this state, less the seed's load.
@@ -585,31 +595,34 @@ impl Slave {
 
 /// The perturbation of motion interface `set`'s held coordinates `τ` into the step when its
 /// driving frame `frame` (at the step's start) has its input `quantity[component]` changed by
-/// one unit: `x = p + v τ + exp([ω τ]×) Q d` (`Q d` for a direction) differentiated.
+/// one unit: `x = p + v τ + a τ²/2 + exp([ω τ + α τ²/2]×) Q d` (`Q d` for a direction)
+/// differentiated, the rates depending on the velocities as `∂a/∂v = ∂α/∂ω = rate` (`seed =
+/// (quantity, component, rate)`; [`DrivingFrame`]).
 fn frame_perturbation(
     set: &NodeSet,
     reference: &[f64],
     frame: &DrivingFrame,
-    quantity: InterfaceQuantity,
-    component: usize,
+    (quantity, component, rate): (InterfaceQuantity, usize, f64),
     tau: f64,
     ds: &mut DynamicState,
 ) {
     use InterfaceQuantity as Q;
-    let turn = *Rotation3::from_scaled_axis(frame.angular_velocity * tau).matrix();
+    let turn = *Rotation3::from_scaled_axis(frame.turn(tau)).matrix();
     let q = frame.rotation;
     let unit = Vector3::ith(component % 3, 1.0);
+    // How far a unit change of a velocity moves the frame: `τ + rate τ²/2`.
+    let reach = tau + 0.5 * rate * tau * tau;
     // δ(Q d) = D d, and δp for a point.
     let (rotation_change, point_change) = match quantity {
         Q::Position => (Matrix3::zeros(), unit),
-        Q::Velocity => (Matrix3::zeros(), tau * unit),
+        Q::Velocity => (Matrix3::zeros(), reach * unit),
         Q::Rotation => {
             let e = Matrix3::from_fn(|r, c| f64::from(u8::from(3 * r + c == component)));
             let a = q.transpose() * e;
             (turn * q * (0.5 * (a - a.transpose())), Vector3::zeros())
         }
         Q::AngularVelocity => {
-            let w = left_jacobian(&(frame.angular_velocity * tau)) * (tau * unit);
+            let w = left_jacobian(&frame.turn(tau)) * (reach * unit);
             (w.cross_matrix() * turn * q, Vector3::zeros())
         }
         _ => (Matrix3::zeros(), Vector3::zeros()),
