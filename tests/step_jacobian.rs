@@ -276,6 +276,60 @@ fn the_dynamic_stiffness_of_a_spinning_motion_interface_is_the_step_derivative()
     assert!(worst < 2e-5, "{worst:e}");
 }
 
+/// A motion sampled at every update and stepped as two halves per update: on the second half
+/// the frame follows the rates it took at the update (`DrivingFrame`), and a velocity given at
+/// the half step changes those rates over the half step back to the update,
+/// `∂a/∂v = 1 / (t − t_update)`: the Jacobian takes it. The driven cantilever's root moved along
+/// y by `c t³/6` (c = 20 m/s³), position and velocity given every 10 ms, steps of 5 ms; at
+/// 0.2 s the second half step's derivative with respect to `root.velocity[2]` against repeated
+/// steps (the velocity set to where the frame had carried it, then changed by ±1e-3 m/s).
+/// Without the rates' dependence the velocity's column was a third low.
+#[test]
+fn a_velocity_given_between_updates_changes_the_rates_the_frame_follows() {
+    let c = 20.0;
+    let big_h = 1e-2;
+    let h = 0.5 * big_h;
+    let mut s = initialized(
+        example_body("driven_cantilever"),
+        &[
+            ("solver.tolerance", 1e-14),
+            ("model.accuracy", 0.0),
+            ("solver.stepSize", h),
+        ],
+    );
+    let given = |s: &mut Slave, t: f64| {
+        set(s, "root.position[2]", c * t * t * t / 6.0);
+        set(s, "root.velocity[2]", c * t * t / 2.0);
+    };
+    for k in 0..20 {
+        let t = k as f64 * big_h;
+        given(&mut s, t);
+        s.do_step(t, h).unwrap();
+        s.do_step(t + h, h).unwrap();
+    }
+    let t_update = 20.0 * big_h;
+    given(&mut s, t_update);
+    s.do_step(t_update, h).unwrap();
+    let t = t_update + h;
+    let saved = s.get_state();
+    // Where the frame carries the velocity: the mean rate of the last update's interval.
+    let v = |t: f64| c * t * t / 2.0;
+    let carried = v(t_update) + (v(t_update) - v(t_update - big_h)) / big_h * h;
+    let prepare = move |s: &mut Slave| set(s, "root.velocity[2]", carried);
+    let outputs = [
+        "root.force[2]",
+        "root.torque[3]",
+        "tip.position[2]",
+        "tip.velocity[2]",
+    ];
+    let inputs = ["root.velocity[2]"];
+    let deltas = [1e-3];
+    let numeric = stepped_differences(&mut s, &prepare, &saved, t, h, &outputs, &inputs, &deltas);
+    let analytic = step_jacobian(&mut s, &prepare, &saved, t, h, &outputs, &inputs);
+    let worst = worst_relative_difference(&outputs, inputs.len(), &analytic, &numeric);
+    assert!(worst < 2e-5, "{worst:e}");
+}
+
 #[test]
 fn the_jacobian_leaves_the_run_as_it_was() {
     // A run that asks for the Jacobian after every step steps on bit for bit like one that

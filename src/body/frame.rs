@@ -239,10 +239,50 @@ impl FrameWeights {
     }
 }
 
+/// The left Jacobian of the rotation vector `φ`: `exp([φ + δ]×) = exp([J_l(φ) δ]×) exp([φ]×)` to
+/// first order, `J_l = I + (1 − cos θ)/θ² [φ]× + (θ − sin θ)/θ³ [φ]×²`, `θ = |φ|`.
+pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
+    let theta = phi.norm();
+    let k = phi.cross_matrix();
+    let (a, b) = if theta < 1e-4 {
+        (
+            0.5 - theta * theta / 24.0,
+            1.0 / 6.0 - theta * theta / 120.0,
+        )
+    } else {
+        (
+            (1.0 - theta.cos()) / (theta * theta),
+            (theta - theta.sin()) / (theta * theta * theta),
+        )
+    };
+    Matrix3::identity() + a * k + b * k * k
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use nalgebra::Rotation3;
+
+    #[test]
+    fn the_left_jacobian_is_the_derivative_of_the_exponential() {
+        for phi in [
+            Vector3::new(0.3, -0.2, 1.1),
+            Vector3::new(1e-6, 2e-6, -1e-6),
+        ] {
+            let j = left_jacobian(&phi);
+            let exp = |v: Vector3<f64>| *Rotation3::from_scaled_axis(v).matrix();
+            for c in 0..3 {
+                let e = 1e-6;
+                let d = Vector3::ith(c, e);
+                let numeric = (exp(phi + d) - exp(phi - d)) / (2.0 * e);
+                let analytic = (j * Vector3::ith(c, 1.0)).cross_matrix() * exp(phi);
+                assert!(
+                    (numeric - analytic).amax() < 1e-9,
+                    "φ = {phi:?}, component {c}: {numeric} against {analytic}"
+                );
+            }
+        }
+    }
 
     fn cloud() -> Vec<f64> {
         // an irregular cloud of 7 points

@@ -2,7 +2,7 @@
 //! force and torque over the nodes, the weighted least-squares rigid motion of the nodes that is
 //! power-conjugate to it, and the resultant of nodal loads about the reference point.
 
-use super::frame::{add_node, node, set_node, Frame, FrameWeights};
+use super::frame::{add_node, left_jacobian, node, set_node, Frame, FrameWeights};
 use crate::error::{Error, Result};
 use nalgebra::{Matrix3, Vector3};
 use std::cell::RefCell;
@@ -264,20 +264,22 @@ impl NodeSet {
     }
 }
 
-/// A driving frame given by a motion interface's inputs at the start of a communication step:
-/// origin `p`, rotation `Q`, velocity `v` and angular velocity `ω` (global).
+/// The driving frame of a motion interface, as its inputs gave it at `changed_at` (s), the last
+/// time they changed the motion: origin `p`, rotation `Q`, velocity `v` and angular velocity `ω`
+/// (global), and `updated_at` (s), the last time they were given (changed or not).
 ///
-/// Its velocities change only where the inputs do: `acceleration` and `angular_acceleration`
-/// are their mean rates over the time between the last two changes, `(v_k − v_{k−1}) / Δt`
-/// (m/s², rad/s²; zero before the second), and `changed_at` (s) the time of the last change:
-/// the driving motion's accelerations as a reduced body's stiffening takes them.
+/// `acceleration` and `angular_acceleration` are the mean rates of the velocities between their
+/// last two changes, `(v_k − v_{k−1}) / Δt` (m/s², rad/s²; zero before the second): the driving
+/// motion's accelerations as a reduced body's stiffening takes them.
 ///
-/// Over a step it is extrapolated with constant velocities, `p(τ) = p + v τ`,
-/// `Q(τ) = exp([ω τ]×) Q`, unless its velocities are samples of a smooth motion (they changed at
-/// this update and at one shortly before it, and the pose given lies on the path of their mean
-/// rate: `rate_span = Δt > 0`, docs/fmu.md, "Inputs are samples in time"). It is then extrapolated with those rates too (`a`, `α`):
-/// `p(τ) = p + v τ + a τ²/2`, `Q(τ) = exp([ω τ + α τ²/2]×) Q`, `v(τ) = v + a τ`,
-/// `ω(τ) = ω + α τ` (exact for `α ∥ ω`, to `O(τ³)` otherwise).
+/// At `t`, `τ = t − changed_at` after it was given, the frame is `p + v τ`, `exp([ω τ]×) Q`
+/// with constant velocities, unless its velocities are samples of a smooth motion (they changed
+/// at the update before too, or the frame already followed its rates, and the pose given lies on
+/// the path of their mean: `rate_span = Δt > 0`, docs/fmu.md, "Inputs are samples in time"). It
+/// then follows those rates too (`a`, `α`): `p + v τ + a τ²/2`, `exp([φ]×) Q` with
+/// `φ = ω τ + α τ²/2`, velocity `v + a τ` and angular velocity `J_l(φ) φ̇`, the path's own
+/// (`J_l` the left Jacobian of the rotation vector; `ω + α τ` when `α ∥ ω`). Every time is
+/// measured from the inputs as given, so a frame carried over several steps is the frame of one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrivingFrame {
     pub position: Vector3<f64>,
@@ -287,9 +289,10 @@ pub struct DrivingFrame {
     pub acceleration: Vector3<f64>,
     pub angular_acceleration: Vector3<f64>,
     pub changed_at: f64,
-    /// The time between the two changes the rates come from when the frame is extrapolated
-    /// with them (s); zero when it is extrapolated with constant velocities.
+    /// The time between the two changes the rates come from when the frame follows them (s);
+    /// zero when it keeps constant velocities.
     pub rate_span: f64,
+    pub updated_at: f64,
 }
 
 impl Default for DrivingFrame {
@@ -303,13 +306,14 @@ impl Default for DrivingFrame {
             angular_acceleration: Vector3::zeros(),
             changed_at: 0.0,
             rate_span: 0.0,
+            updated_at: 0.0,
         }
     }
 }
 
 impl DrivingFrame {
-    /// The rates the frame is extrapolated with: `(a, α)` when its velocities are samples of a
-    /// smooth motion (`rate_span > 0`), zero otherwise.
+    /// The rates the frame follows: `(a, α)` when its velocities are samples of a smooth motion
+    /// (`rate_span > 0`), zero otherwise.
     pub fn extrapolation_rates(&self) -> (Vector3<f64>, Vector3<f64>) {
         if self.rate_span > 0.0 {
             (self.acceleration, self.angular_acceleration)
@@ -318,38 +322,48 @@ impl DrivingFrame {
         }
     }
 
-    /// The rotation vector of the turn over `τ`: `ω τ + α τ²/2`.
-    pub fn turn(&self, tau: f64) -> Vector3<f64> {
+    /// The rotation vector of the turn from `changed_at` to `t`: `φ = ω τ + α τ²/2`.
+    pub fn turn(&self, t: f64) -> Vector3<f64> {
+        let tau = t - self.changed_at;
         let (_, alpha) = self.extrapolation_rates();
         self.angular_velocity * tau + alpha * (0.5 * tau * tau)
     }
 
-    /// Origin and rotation `τ` seconds after the step's start.
-    pub fn at(&self, tau: f64) -> (Vector3<f64>, Matrix3<f64>) {
+    /// Origin and rotation at `t`.
+    pub fn at(&self, t: f64) -> (Vector3<f64>, Matrix3<f64>) {
+        let tau = t - self.changed_at;
         let (a, _) = self.extrapolation_rates();
-        let turn = nalgebra::Rotation3::from_scaled_axis(self.turn(tau));
+        let turn = nalgebra::Rotation3::from_scaled_axis(self.turn(t));
         (
             self.position + self.velocity * tau + a * (0.5 * tau * tau),
             turn.matrix() * self.rotation,
         )
     }
 
-    /// Velocity and angular velocity `τ` seconds after the step's start.
-    pub fn velocities_at(&self, tau: f64) -> (Vector3<f64>, Vector3<f64>) {
+    /// Velocity and angular velocity at `t`: `v + a τ` and `J_l(φ) (ω + α τ)`.
+    pub fn velocities_at(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let tau = t - self.changed_at;
         let (a, alpha) = self.extrapolation_rates();
-        (self.velocity + a * tau, self.angular_velocity + alpha * tau)
+        let angular = if self.rate_span > 0.0 {
+            left_jacobian(&self.turn(t)) * (self.angular_velocity + alpha * tau)
+        } else {
+            self.angular_velocity
+        };
+        (self.velocity + a * tau, angular)
     }
 
-    /// The same motion `τ` seconds later: the frame a step of `τ` leaves to the next one when
-    /// the inputs are not set again.
-    pub fn advanced(&self, tau: f64) -> DrivingFrame {
-        let (position, rotation) = self.at(tau);
-        let (velocity, angular_velocity) = self.velocities_at(tau);
+    /// The frame as it stands at `t`, given anew there: pose and velocities at `t`, the same
+    /// rates (for what takes the motion at one time: a step's start, the inputs of an interface
+    /// set in part).
+    pub fn advanced_to(&self, t: f64) -> DrivingFrame {
+        let (position, rotation) = self.at(t);
+        let (velocity, angular_velocity) = self.velocities_at(t);
         DrivingFrame {
             position,
             rotation,
             velocity,
             angular_velocity,
+            changed_at: t,
             ..*self
         }
     }
@@ -375,20 +389,21 @@ impl NodeSet {
         }
     }
 
-    /// Clamps the nodes to `frame` at `τ`: `x_i = p(τ) + Q(τ)(X_i − X_ref)`,
-    /// `ẋ_i = v(τ) + ω(τ) × r_i`, `ẍ_i = a + α × r_i + ω(τ) × (ω(τ) × r_i)` with
-    /// `r_i = x_i − p(τ)` (X_ref: the reference point; `a`, `α` the frame's extrapolation rates).
+    /// Clamps the nodes to `frame` at time `t`: `x_i = p(t) + Q(t)(X_i − X_ref)`,
+    /// `ẋ_i = v(t) + ω(t) × r_i`, `ẍ_i = a + α × r_i + ω(t) × (ω(t) × r_i)` with
+    /// `r_i = x_i − p(t)` (X_ref: the reference point; `a`, `α` the rates the frame follows; the
+    /// angular acceleration of the path is `α` to `O(|ω × α| τ)`).
     pub fn prescribe(
         &self,
         reference: &[f64],
         frame: &DrivingFrame,
-        tau: f64,
+        t: f64,
         x: &mut [f64],
         v: &mut [f64],
         a: &mut [f64],
     ) {
-        let (p, q) = frame.at(tau);
-        let (velocity, w) = frame.velocities_at(tau);
+        let (p, q) = frame.at(t);
+        let (velocity, w) = frame.velocities_at(t);
         let (acceleration, alpha) = frame.extrapolation_rates();
         self.for_each_held(reference, |index, offset, point| {
             let r = q * offset;
@@ -496,44 +511,46 @@ fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64>
 mod tests {
     use super::*;
 
-    /// A frame following its rates is a quadratic path: carried on by `τ₁` and then `τ₂` it is
-    /// where it is carried on by `τ₁ + τ₂` (turning about one axis), and carried back by the
-    /// time since its inputs were given it is those inputs again.
+    /// A frame following its rates is one path measured from its inputs: advanced to `t₁` it
+    /// stands where the path is at `t₁`, its origin is `p + v τ + a τ²/2` and its angular
+    /// velocity the derivative of its rotation (`ω` and `α` on different axes); without a span
+    /// it keeps constant velocities.
     #[test]
-    fn a_frame_following_its_rates_carries_on_as_one_path() {
-        let axis = Vector3::new(0.3, -0.5, 0.8).normalize();
+    fn a_frame_following_its_rates_is_one_path() {
         let given = DrivingFrame {
             position: Vector3::new(1.0, 2.0, -0.5),
             rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
             velocity: Vector3::new(0.5, -1.0, 2.0),
-            angular_velocity: 1.5 * axis,
+            angular_velocity: Vector3::new(0.3, 1.5, -0.2),
             acceleration: Vector3::new(3.0, 1.0, -2.0),
-            angular_acceleration: -4.0 * axis,
-            changed_at: 0.0,
+            angular_acceleration: Vector3::new(-4.0, 0.5, 2.0),
+            changed_at: 1.0,
             rate_span: 0.01,
+            updated_at: 1.0,
         };
-        let (a, b) = (given.advanced(0.013).advanced(0.021), given.advanced(0.034));
-        assert!((a.position - b.position).amax() < 1e-14);
-        assert!((a.rotation - b.rotation).amax() < 1e-14);
-        assert!((a.velocity - b.velocity).amax() < 1e-14);
-        assert!((a.angular_velocity - b.angular_velocity).amax() < 1e-14);
-        let back = b.advanced(-0.034);
-        assert!((back.position - given.position).amax() < 1e-14);
-        assert!((back.rotation - given.rotation).amax() < 1e-14);
-        assert!((back.velocity - given.velocity).amax() < 1e-14);
-        // p + v τ + a τ²/2 and ω + α τ.
-        let tau = 0.034;
+        let (t1, t2) = (1.013, 1.034);
+        let (a, b) = (given.advanced_to(t1), given);
+        let (pa, qa) = a.at(t1);
+        let (pb, qb) = b.at(t1);
+        assert!((pa - pb).amax() < 1e-14 && (qa - qb).amax() < 1e-14);
+        assert_eq!(a.velocities_at(t1), b.velocities_at(t1));
+        let (pb, qb) = b.at(t2);
+        let tau = t2 - 1.0;
         let p = given.position + given.velocity * tau + given.acceleration * (0.5 * tau * tau);
-        assert!((b.position - p).amax() < 1e-14);
-        assert!((b.angular_velocity - (1.5 - 4.0 * tau) * axis).amax() < 1e-14);
-        // Without a span, constant velocities.
+        assert!((pb - p).amax() < 1e-14);
+        // The angular velocity is Q̇ Qᵀ of the path (central differences).
+        let e = 1e-6;
+        let dq = (b.at(t2 + e).1 - b.at(t2 - e).1) / (2.0 * e);
+        let w = dq * qb.transpose();
+        let (_, omega) = b.velocities_at(t2);
+        assert!((Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]) - omega).amax() < 1e-8);
         let held = DrivingFrame {
             rate_span: 0.0,
             ..given
-        }
-        .advanced(tau);
-        assert!((held.position - (given.position + given.velocity * tau)).amax() < 1e-14);
-        assert_eq!(held.velocity, given.velocity);
+        };
+        let (p, _) = held.at(t2);
+        assert!((p - (given.position + given.velocity * tau)).amax() < 1e-14);
+        assert_eq!(held.velocities_at(t2).0, given.velocity);
     }
 
     fn face() -> (Vec<f64>, NodeSet) {

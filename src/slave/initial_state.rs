@@ -98,7 +98,7 @@ impl Slave {
             &model.body,
             &self.interfaces,
             &self.driving,
-            0.0,
+            self.start_time,
             &mut state,
         );
         self.hold_point_constraints(&state, &placement)?;
@@ -237,7 +237,7 @@ impl Slave {
             interface.set.prescribe(
                 &body.reference,
                 &self.driving[k],
-                0.0,
+                self.start_time,
                 &mut placed.position,
                 &mut placed.velocity,
                 &mut placed.acceleration,

@@ -151,12 +151,12 @@ pub(super) fn driving_frame(name: &str, values: &Inputs) -> Result<DrivingFrame>
     })
 }
 
-/// Clamps the nodes of every motion interface to its driving frame `tau` seconds into the step.
+/// Clamps the nodes of every motion interface to its driving frame at time `t`.
 pub(super) fn prescribe_motion(
     body: &Body,
     interfaces: &[Interface],
     driving: &[DrivingFrame],
-    tau: f64,
+    t: f64,
     state: &mut DynamicState,
 ) {
     for (interface, frame) in interfaces.iter().zip(driving) {
@@ -164,7 +164,7 @@ pub(super) fn prescribe_motion(
             interface.set.prescribe(
                 &body.reference,
                 frame,
-                tau,
+                t,
                 &mut state.position,
                 &mut state.velocity,
                 &mut state.acceleration,
@@ -215,15 +215,6 @@ pub(super) fn apply_loads(
     }
 }
 
-/// A motion interface's velocities count as samples of a smooth motion, and its frame is
-/// extrapolated with their rates ([`DrivingFrame`]), when they change again within this many
-/// of the last communication step (4 steps, and a half for rounding: an importer that sets the
-/// motion at every update, or at every other as OMSimulator does now and then) and the pose
-/// given with them lies on the smooth path rather than the held one ([`follows_rates`]). A
-/// change after a longer calm stretch is a step of the velocity, held from there (docs/fmu.md,
-/// "Inputs are samples in time").
-pub const RATES_WITHIN: f64 = 4.5;
-
 /// Whether the pose `new` given `since` seconds after the inputs `given` shows the velocities as
 /// samples of a smooth motion: it lies nearer the path with the mean rates of the velocities
 /// between the two (`new`'s accelerations; the velocities' mean, `p + (v + v_new) Δt / 2`) than the
@@ -235,22 +226,23 @@ fn follows_rates(given: &DrivingFrame, new: &DrivingFrame, since: f64, size: f64
         rate_span: 0.0,
         ..*given
     };
-    let held = from.advanced(since);
+    let t = given.changed_at + since;
+    let held = from.at(t);
     let smooth = DrivingFrame {
         acceleration: new.acceleration,
         angular_acceleration: new.angular_acceleration,
         rate_span: since,
         ..from
     }
-    .advanced(since);
-    let distance = |a: &DrivingFrame| {
-        let m = new.rotation * a.rotation.transpose();
+    .at(t);
+    let distance = |(p, q): &(Vector3<f64>, Matrix3<f64>)| {
+        let m = new.rotation * q.transpose();
         let turn = Vector3::new(
             m[(2, 1)] - m[(1, 2)],
             m[(0, 2)] - m[(2, 0)],
             m[(1, 0)] - m[(0, 1)],
         );
-        (new.position - a.position).norm() + 0.5 * size * turn.norm()
+        (new.position - p).norm() + 0.5 * size * turn.norm()
     };
     distance(&smooth) < distance(&held)
 }
@@ -323,40 +315,42 @@ impl Slave {
             self.input_ages[k] = age;
             match interface.kind {
                 InterfaceKind::Motion => {
-                    let old = self.driving[k];
-                    let carried = old.advanced(last);
                     if age != 0.0 && last > 0.0 {
                         // Not set since the last step began: the motion carries on.
-                        self.driving[k] = carried;
                         continue;
                     }
+                    let old = self.driving[k];
                     let mut frame =
                         driving_frame(&self.body_file.interfaces[k].name, &self.inputs[k])?;
                     if age != 0.0 {
+                        // Given before initialization at an earlier time: held from there.
                         (frame.position, frame.rotation) = frame.at(age);
                     }
-                    if last > 0.0 && !frames_differ(&carried, &frame) {
-                        // Set again to where the motion had carried on to.
-                        self.driving[k] = carried;
-                        continue;
-                    }
-                    jumped |= last > 0.0;
-                    motion_jumped |= last > 0.0;
-                    // The velocities' mean rates since their last change (`DrivingFrame`),
-                    // from the inputs given then (the old frame carried on from them).
-                    let since = t - old.changed_at;
-                    if last > 0.0 && since > 0.0 {
-                        let given = old.advanced(old.changed_at - (t - last));
-                        frame.acceleration = (frame.velocity - given.velocity) / since;
-                        frame.angular_acceleration =
-                            (frame.angular_velocity - given.angular_velocity) / since;
-                        if since <= RATES_WITHIN * last
-                            && follows_rates(&given, &frame, since, self.size)
-                        {
-                            frame.rate_span = since;
+                    (frame.changed_at, frame.updated_at) = (t, t);
+                    if last > 0.0 {
+                        if !frames_differ(&old.advanced_to(t), &frame) {
+                            // Given again where the motion had carried on to.
+                            self.driving[k].updated_at = t;
+                            continue;
+                        }
+                        jumped = true;
+                        motion_jumped = true;
+                        // The velocities' mean rates since they were last given
+                        // (`DrivingFrame`); followed when they are samples of a smooth motion:
+                        // they changed at the update before too (not a step of the velocity
+                        // after a calm stretch) or the frame followed its rates already, and the
+                        // pose says so ([`follows_rates`]).
+                        let since = t - old.changed_at;
+                        if since > 0.0 {
+                            frame.acceleration = (frame.velocity - old.velocity) / since;
+                            frame.angular_acceleration =
+                                (frame.angular_velocity - old.angular_velocity) / since;
+                            let calm = old.rate_span == 0.0 && old.updated_at > old.changed_at;
+                            if !calm && follows_rates(&old, &frame, since, self.size) {
+                                frame.rate_span = since;
+                            }
                         }
                     }
-                    frame.changed_at = t;
                     self.driving[k] = frame;
                 }
                 InterfaceKind::Force if age == 0.0 => {
@@ -370,15 +364,15 @@ impl Slave {
         Ok((jumped, motion_jumped))
     }
 
-    /// The driving frame of the motion interface at the start of the current step, with the
-    /// mean rates of its velocities between their last two changes (`None` without one; a body
-    /// whose stiffening takes it has exactly one). Part of the FMU state.
-    pub(super) fn motion_frame(&self) -> Option<&DrivingFrame> {
+    /// The driving frame of the motion interface as it stands at the start of the current step,
+    /// with the mean rates of its velocities between their last two changes (`None` without
+    /// one; a body whose stiffening takes it has exactly one). Part of the FMU state.
+    pub(super) fn motion_frame(&self) -> Option<DrivingFrame> {
         let k = self
             .interfaces
             .iter()
             .position(|i| i.kind == InterfaceKind::Motion)?;
-        Some(&self.driving[k])
+        Some(self.driving[k].advanced_to(self.time()))
     }
 
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or
@@ -399,20 +393,9 @@ impl Slave {
         let input = &mut self.inputs[k];
         match self.interfaces[k].kind {
             InterfaceKind::Motion => {
+                // The inputs carry on as the driving frame made from them does (with its rates).
+                let frame = self.driving[k].advanced_to(t);
                 let slot = |q: InterfaceQuantity| q.slot() as usize;
-                let vector = |input: &Inputs, q: InterfaceQuantity| {
-                    Vector3::from_column_slice(&input[slot(q)..slot(q) + 3])
-                };
-                let r = slot(InterfaceQuantity::Rotation);
-                // The inputs carry on as the driving frame made from them does, with its rates.
-                let frame = DrivingFrame {
-                    position: vector(input, InterfaceQuantity::Position),
-                    rotation: Matrix3::from_row_slice(&input[r..r + 9]),
-                    velocity: vector(input, InterfaceQuantity::Velocity),
-                    angular_velocity: vector(input, InterfaceQuantity::AngularVelocity),
-                    ..self.driving[k]
-                }
-                .advanced(tau);
                 for (quantity, value) in [
                     (InterfaceQuantity::Position, frame.position),
                     (InterfaceQuantity::Velocity, frame.velocity),
@@ -420,6 +403,7 @@ impl Slave {
                 ] {
                     input[slot(quantity)..slot(quantity) + 3].copy_from_slice(value.as_slice());
                 }
+                let r = slot(InterfaceQuantity::Rotation);
                 for (j, value) in input[r..r + 9].iter_mut().enumerate() {
                     *value = frame.rotation[(j / 3, j % 3)];
                 }

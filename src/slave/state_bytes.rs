@@ -11,7 +11,7 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
-//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span) f64: each motion interface's frame at the start of the last step (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes and the time between them when the frame is extrapolated with them (0: not) |
+//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span, time of the last update) f64: each motion interface's frame as given at its last change (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes, the time between them when the frame follows them (0: not) and when its inputs were last given |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | stop time | u8 (1: defined), f64 (0 when not) |
@@ -207,6 +207,7 @@ impl SlaveState {
             w.f64s(f.angular_acceleration.as_slice());
             w.f64(f.changed_at);
             w.f64(f.rate_span);
+            w.f64(f.updated_at);
         }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
@@ -281,7 +282,7 @@ impl Slave {
         r.f64s(&mut input_times, "an input sample time")?;
         let mut driving = vec![DrivingFrame::default(); n];
         for f in &mut driving {
-            let mut v = [0.0; 26];
+            let mut v = [0.0; 27];
             r.f64s(&mut v, "a driving frame")?;
             f.position = Vector3::from_column_slice(&v[0..3]);
             f.rotation = Matrix3::from_row_slice(&v[3..12]);
@@ -291,6 +292,7 @@ impl Slave {
             f.angular_acceleration = Vector3::from_column_slice(&v[21..24]);
             f.changed_at = v[24];
             f.rate_span = v[25];
+            f.updated_at = v[26];
         }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;

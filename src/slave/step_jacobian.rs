@@ -4,6 +4,7 @@
 
 use super::interfaces::apply_loads;
 use super::{Inputs, Slave};
+use crate::body::frame::left_jacobian;
 use crate::body::frame::set_node;
 use crate::body::interface::{DrivingFrame, NodeSet};
 use crate::error::{Error, Result};
@@ -433,17 +434,16 @@ impl Slave {
                 component,
             } => Some((
                 &self.interfaces[interface].set,
-                self.driving[interface],
+                self.driving[interface].advanced_to(start),
                 quantity,
                 component,
-                // The rates a frame is extrapolated with come from the velocities given at its
-                // change (`DrivingFrame`): `∂a/∂v = 1 / rate_span` when that is now.
-                if self.driving[interface].rate_span > 0.0
-                    && self.driving[interface].changed_at == start
-                {
-                    1.0 / self.driving[interface].rate_span
-                } else {
-                    0.0
+                // The rates the frame follows come from the velocities given at `start`
+                // (`DrivingFrame`): `a = (v − v_given) / Δt`, `∂a/∂v = 1 / Δt`, `Δt` back to the
+                // change before (this step's own when it changed at `start`).
+                match self.driving[interface] {
+                    f if f.rate_span > 0.0 && f.changed_at == start => 1.0 / f.rate_span,
+                    f if f.rate_span > 0.0 && f.changed_at < start => 1.0 / (start - f.changed_at),
+                    _ => 0.0,
                 },
             )),
             Seed::Load { .. } => None,
@@ -607,7 +607,8 @@ fn frame_perturbation(
     ds: &mut DynamicState,
 ) {
     use InterfaceQuantity as Q;
-    let turn = *Rotation3::from_scaled_axis(frame.turn(tau)).matrix();
+    let t = frame.changed_at + tau;
+    let turn = *Rotation3::from_scaled_axis(frame.turn(t)).matrix();
     let q = frame.rotation;
     let unit = Vector3::ith(component % 3, 1.0);
     // How far a unit change of a velocity moves the frame: `τ + rate τ²/2`.
@@ -622,7 +623,7 @@ fn frame_perturbation(
             (turn * q * (0.5 * (a - a.transpose())), Vector3::zeros())
         }
         Q::AngularVelocity => {
-            let w = left_jacobian(&frame.turn(tau)) * (reach * unit);
+            let w = left_jacobian(&frame.turn(t)) * (reach * unit);
             (w.cross_matrix() * turn * q, Vector3::zeros())
         }
         _ => (Matrix3::zeros(), Vector3::zeros()),
@@ -634,49 +635,4 @@ fn frame_perturbation(
         }
         set_node(&mut ds.position, index, &dx);
     });
-}
-
-/// The left Jacobian of the rotation vector `φ`: `exp([φ + δ]×) = exp([J_l(φ) δ]×) exp([φ]×)` to
-/// first order, `J_l = I + (1 − cos θ)/θ² [φ]× + (θ − sin θ)/θ³ [φ]×²`, `θ = |φ|`.
-fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
-    let theta = phi.norm();
-    let k = phi.cross_matrix();
-    let (a, b) = if theta < 1e-4 {
-        (
-            0.5 - theta * theta / 24.0,
-            1.0 / 6.0 - theta * theta / 120.0,
-        )
-    } else {
-        (
-            (1.0 - theta.cos()) / (theta * theta),
-            (theta - theta.sin()) / (theta * theta * theta),
-        )
-    };
-    Matrix3::identity() + a * k + b * k * k
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_left_jacobian_is_the_derivative_of_the_exponential() {
-        for phi in [
-            Vector3::new(0.3, -0.2, 1.1),
-            Vector3::new(1e-6, 2e-6, -1e-6),
-        ] {
-            let j = left_jacobian(&phi);
-            let exp = |v: Vector3<f64>| *Rotation3::from_scaled_axis(v).matrix();
-            for c in 0..3 {
-                let e = 1e-6;
-                let d = Vector3::ith(c, e);
-                let numeric = (exp(phi + d) - exp(phi - d)) / (2.0 * e);
-                let analytic = (j * Vector3::ith(c, 1.0)).cross_matrix() * exp(phi);
-                assert!(
-                    (numeric - analytic).amax() < 1e-9,
-                    "φ = {phi:?}, component {c}: {numeric} against {analytic}"
-                );
-            }
-        }
-    }
 }

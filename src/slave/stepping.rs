@@ -445,7 +445,7 @@ impl Slave {
     /// backup.
     fn prepare_step(&mut self, h: f64) -> Result<()> {
         self.prepare_step_size(h)?;
-        let motion = self.motion_frame().copied();
+        let motion = self.motion_frame();
         let dynamics = self.dynamics.as_mut().unwrap();
         let model = self
             .model

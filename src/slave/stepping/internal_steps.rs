@@ -157,7 +157,7 @@ impl Slave {
         };
         let driving = &self.driving;
         let prescribe = |t: f64, state: &mut DynamicState| {
-            prescribe_motion(body, interfaces, driving, t - t0, state)
+            prescribe_motion(body, interfaces, driving, t, state)
         };
         let problem = StepProblem {
             body,
