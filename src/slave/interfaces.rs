@@ -378,11 +378,11 @@ impl Slave {
     /// Makes the current time the sample time of interface `k`'s inputs, before one of them (or
     /// a derivative) is set. Inputs set at time `t_s` describe the interface at `t_s`; those
     /// not set again continue along their extrapolation, so they are moved to the current time
-    /// `t` (`τ = t − t_s`): a motion interface's pose and velocities as its driving frame
-    /// carries them on ([`DrivingFrame::advanced`]: `p + v τ`, `exp([ω τ]×) Q`, or with the
-    /// frame's rates when its velocities are samples of a smooth motion), a force interface's force and torque with their derivatives
-    /// (`u + u'τ + u''τ²/2`, `u' + u''τ`). Before initialization the inputs describe the start
-    /// time. Allocation-free.
+    /// `t` (`τ = t − t_s`): a motion interface's pose and velocities where its driving frame
+    /// stands at `t` ([`DrivingFrame::advanced_to`]: the inputs it was made from, or matched,
+    /// carried on with constant velocities or with its rates), a force interface's force and
+    /// torque with their derivatives (`u + u'τ + u''τ²/2`, `u' + u''τ`). Before initialization
+    /// the inputs describe the start time. Allocation-free.
     pub(super) fn resample_inputs(&mut self, k: usize) {
         let t = self.time();
         let tau = t - self.input_times[k];
