@@ -239,6 +239,18 @@ impl FrameWeights {
     }
 }
 
+/// The angle `θ` (rad) of the turn `Aᵀ B` between two rotations: from `sin θ` (half the norm of
+/// the skew part's axis, well conditioned at small angles) and, past π/2, from `cos θ`.
+pub fn angle_between(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+    let turn = a.transpose() * b;
+    let axis = Vector3::new(
+        turn[(2, 1)] - turn[(1, 2)],
+        turn[(0, 2)] - turn[(2, 0)],
+        turn[(1, 0)] - turn[(0, 1)],
+    );
+    (0.5 * axis.norm()).atan2(0.5 * (turn.trace() - 1.0))
+}
+
 /// The left Jacobian of the rotation vector `φ`: `exp([φ + δ]×) = exp([J_l(φ) δ]×) exp([φ]×)` to
 /// first order, `J_l = I + (1 − cos θ)/θ² [φ]× + (θ − sin θ)/θ³ [φ]×²`, `θ = |φ|`.
 pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
@@ -262,6 +274,17 @@ pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
 mod tests {
     use super::*;
     use nalgebra::Rotation3;
+
+    #[test]
+    fn the_angle_between_two_rotations_is_that_of_their_turn() {
+        let a = *Rotation3::from_scaled_axis(Vector3::new(0.3, -0.2, 1.1)).matrix();
+        let axis = Vector3::new(1.0, 2.0, -0.5).normalize();
+        for theta in [1e-9, 1e-3, 0.7, 2.5] {
+            let b = Rotation3::from_scaled_axis(axis * theta).matrix() * a;
+            let found = angle_between(&a, &b);
+            assert!((found - theta).abs() < 1e-15 + 1e-12 * theta, "{found} for {theta}");
+        }
+    }
 
     #[test]
     fn the_left_jacobian_is_the_derivative_of_the_exponential() {

@@ -3,9 +3,9 @@
 use super::assembly::Model;
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
+use crate::body::frame::angle_between;
 use crate::body::lowest_modes::MODES;
 use crate::model::category;
-use nalgebra::Vector3;
 
 /// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
 /// finite number: the state's byte form holds finite numbers only).
@@ -223,15 +223,7 @@ fn frame_turn(model: &Model, x: &[f64]) -> Option<f64> {
         .as_ref()
         .or(model.parked_linear.as_ref())?;
     let rotation = model.body.frame_weights.best_fit(x).rotation;
-    let turn = placement.frame.rotation.transpose() * rotation;
-    let axis = Vector3::new(
-        turn[(2, 1)] - turn[(1, 2)],
-        turn[(0, 2)] - turn[(2, 0)],
-        turn[(1, 0)] - turn[(0, 1)],
-    );
-    // θ from sin θ = |axis| / 2 (well conditioned at small angles), and past π/2 from cos θ.
-    let cos = 0.5 * (turn.trace() - 1.0);
-    Some((0.5 * axis.norm()).atan2(cos))
+    Some(angle_between(&placement.frame.rotation, &rotation))
 }
 
 /// After a communication step taken with `model.auto`'s linear body: the frame's rotation `θ`

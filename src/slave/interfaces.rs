@@ -2,7 +2,7 @@
 //! interfaces, the loads of force interfaces, and the inputs as samples in time.
 
 use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
-use crate::body::frame::{nearest_rotation, node};
+use crate::body::frame::{angle_between, nearest_rotation, node};
 use crate::body::interface::DrivingFrame;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
@@ -236,13 +236,7 @@ fn follows_rates(given: &DrivingFrame, new: &DrivingFrame, since: f64, size: f64
     }
     .at(t);
     let distance = |(p, q): &(Vector3<f64>, Matrix3<f64>)| {
-        let m = new.rotation * q.transpose();
-        let turn = Vector3::new(
-            m[(2, 1)] - m[(1, 2)],
-            m[(0, 2)] - m[(2, 0)],
-            m[(1, 0)] - m[(0, 1)],
-        );
-        (new.position - p).norm() + 0.5 * size * turn.norm()
+        (new.position - p).norm() + size * angle_between(q, &new.rotation)
     };
     distance(&smooth) < distance(&held)
 }

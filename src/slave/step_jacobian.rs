@@ -442,7 +442,7 @@ impl Slave {
                 // change before (this step's own when it changed at `start`).
                 match self.driving[interface] {
                     f if f.rate_span > 0.0 && f.changed_at == start => 1.0 / f.rate_span,
-                    f if f.rate_span > 0.0 && f.changed_at < start => 1.0 / (start - f.changed_at),
+                    f if f.rate_span > 0.0 => 1.0 / (start - f.changed_at),
                     _ => 0.0,
                 },
             )),
