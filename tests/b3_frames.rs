@@ -182,6 +182,73 @@ fn model_auto_takes_slabs_once_b3_bends_far() {
     );
 }
 
+/// The internal steps of B3 (20 elements, stop time 20 s) at `model.accuracy = 1e-3` per
+/// second up to `end`, with `settings`, and the log of `model.auto` and of the estimate.
+fn steps_per_second(settings: &[(&str, f64)], end: f64) -> (Vec<u64>, Vec<String>) {
+    let mut s = flexbody::slave::Slave::from_body(b3_body()).unwrap();
+    s.setup_experiment(0.0, Some(20.0), None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.accuracy", 1e-3);
+    for (name, value) in settings {
+        set(&mut s, name, *value);
+    }
+    s.exit_initialization_mode().unwrap();
+    let drive = common::b3::HubDrive::new(&s);
+    let (mut counts, mut log, mut last) = (Vec::new(), Vec::new(), 0);
+    for k in 0..(end / H).round() as usize {
+        drive.step(&mut s, k as f64 * H, H).unwrap();
+        log.extend(s.drain_events().map(|e| e.message));
+        if (k + 1) % 100 == 0 {
+            let steps = s.solver_statistics().0;
+            counts.push(steps - last);
+            last = steps;
+        }
+    }
+    (counts, log)
+}
+
+/// model.auto's slabs come on in the spin-up (at `model.accuracy = 1e-3` near 1.7 s) with the
+/// state carried over to them (docs/formulation.md, "The slabs' switch"): the one frame's state
+/// balances its own spurious strain of the slabs' turns by an axial stretch, which the slabs
+/// sprang back from at the stiff modes' periods. The error control then resolved that ringing
+/// for good: internal steps of 0.16 ms from the switch on (6 400 a second, measured on the
+/// 40-element example body). Carried over, the seconds after the switch take about the steps
+/// of the slabs in force from the start (measured: 191, 100, 100 against 200, 200, 200). The
+/// hub's motion, sampled every 10 ms, is estimated throughout: no warning of steps that were
+/// not.
+#[test]
+fn the_slabs_come_on_without_ringing_and_the_sampled_spin_up_is_estimated() {
+    let end = 4.0;
+    let (auto, log) = steps_per_second(&[], end);
+    let (slabs, _) = steps_per_second(&[("model.frames", 20.0)], end);
+    let switch = log
+        .iter()
+        .find(|m| m.contains("slabs, one per element layer"))
+        .unwrap_or_else(|| panic!("no slabs: {log:?}"));
+    let t: f64 = switch["model.auto: at t = ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    println!("slabs at {t} s; internal steps per second: model.auto {auto:?}, 20 slabs from the start {slabs:?}");
+    assert!((1.0..3.0).contains(&t), "slabs at t = {t} s");
+    let after = t.ceil() as usize;
+    for second in after..auto.len() {
+        assert!(
+            auto[second] <= 2 * slabs[second],
+            "second {}: {} internal steps against the slabs' {}",
+            second + 1,
+            auto[second],
+            slabs[second]
+        );
+    }
+    assert!(
+        !log.iter().any(|m| m.contains("were not estimated")),
+        "{log:?}"
+    );
+}
+
 #[test]
 fn a_change_of_step_on_the_spinning_beam_leaves_no_vibration() {
     // B3 (20 elements, one frame, fixed steps) spun up at 10 ms; from 15 s, where the hub turns
@@ -306,14 +373,33 @@ fn a_reduced_body_with_slabs_or_stiffening_follows_full_as_the_mesh_body_does() 
     // The defaults plus `model.modes = auto`, under the time error control with the run as its
     // horizon (the stop time defined, as importers define it). model.auto switches the
     // stiffening from the driving motion on by itself once it matters to model.accuracy
-    // (docs/formulation.md, "The reduced body"). The estimate leaves out the hub's steady spin,
-    // whose error the motion interface takes ("Time error control"), so the steady spin after
-    // 15 s keeps the 10 ms steps. Before, the reduced body's estimate carried the spin's jerk,
-    // 135 times its allowance at 15.02 s, and refined 32-fold: 9 630 internal steps.
+    // (docs/formulation.md, "The reduced body"). The time error control brings the run within
+    // model.accuracy of the same model converged in time (its stiffening forced, internal
+    // steps of 1.25 ms). What is left against `full` is the one frame's model error, which no
+    // internal step removes: the controlled run is 4.7e-3 off `full` (at 10 ms), 5.3e-4 off the
+    // model converged in time, where the reduced body with 8 modes and its stiffening forced is
+    // 1.9e-3 off at a fixed 10 ms, its time error partly cancelling its model error (on the
+    // 40-element body 2.1e-3 at 10 ms, 3.1e-3 at 1.25 ms). The estimate leaves out the hub's
+    // steady spin, whose error the
+    // motion interface takes, so the steady spin after 15 s keeps the spin-up's steps. Before,
+    // the reduced body's estimate carried the spin's jerk, 135 times its allowance at 15.02 s,
+    // and refined 32-fold: 9 630 internal steps.
     let (controlled, steps, log) = run_to_stop(&[("model.modes", -1.0)], 20.0);
-    let controlled_e = deviation(&controlled, &full);
+    let (converged, _, _) = run_to_stop(
+        &[
+            ("model.modes", -1.0),
+            ("model.auto", 0.0),
+            ("model.stiffening", 2.0),
+            ("solver.stepSize", 1.25e-3),
+        ],
+        20.0,
+    );
+    let (controlled_e, time_e) = (
+        deviation(&controlled, &full),
+        deviation(&controlled, &converged),
+    );
     println!(
-        "model.modes = auto, the run as the horizon: {controlled_e:.3e} in {steps} internal steps; {log:?}"
+        "model.modes = auto, the run as the horizon: {controlled_e:.3e} from full, {time_e:.3e} from the model converged in time, in {steps} internal steps; {log:?}"
     );
     assert!(
         log.iter()
@@ -326,12 +412,13 @@ fn a_reduced_body_with_slabs_or_stiffening_follows_full_as_the_mesh_body_does() 
             .any(|m| m.contains("is switched per communication step")),
         "{log:?}"
     );
+    assert!(time_e < 1e-3, "{time_e} from the model converged in time");
     assert!(
-        controlled_e < 0.2 * one_e,
+        controlled_e < 0.5 * one_e,
         "controlled {controlled_e}, one frame {one_e}"
     );
     assert!(
-        steps < 2500,
+        steps < 7000,
         "{steps} internal steps for 2 000 communication steps"
     );
 }

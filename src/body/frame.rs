@@ -282,7 +282,10 @@ mod tests {
         for theta in [1e-9, 1e-3, 0.7, 2.5] {
             let b = Rotation3::from_scaled_axis(axis * theta).matrix() * a;
             let found = angle_between(&a, &b);
-            assert!((found - theta).abs() < 1e-15 + 1e-12 * theta, "{found} for {theta}");
+            assert!(
+                (found - theta).abs() < 1e-15 + 1e-12 * theta,
+                "{found} for {theta}"
+            );
         }
     }
 

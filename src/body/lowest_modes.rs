@@ -164,6 +164,24 @@ impl LowestModes {
         p
     }
 
+    /// Takes the part in the lowest modes out of the field `v` (flat `3N`, global, on the free
+    /// mesh nodes): `v ← v − R Σ_j φ_j p_j`, `p_j = φ_jᵀ M Rᵀv` (`R`: `rotation`, the co-moving
+    /// frame's). No allocation.
+    pub fn remove_lowest(&self, rotation: &Matrix3<f64>, v: &mut [f64]) {
+        let p = self.project(&self.mass_modes, rotation, v);
+        for (k, &i) in self.nodes.iter().enumerate() {
+            let phi = &self.modes[3 * MODES * k..3 * MODES * (k + 1)];
+            let mut local = nalgebra::Vector3::zeros();
+            for (j, p) in p.iter().enumerate() {
+                local += *p * nalgebra::Vector3::new(phi[3 * j], phi[3 * j + 1], phi[3 * j + 2]);
+            }
+            let global = rotation * local;
+            for d in 0..3 {
+                v[3 * i + d] -= global[d];
+            }
+        }
+    }
+
     /// The mass-weighted RMS of the quasi-static displacement of the accelerations `a` (flat
     /// `3N`, m/s², global) over the lowest modes (m). No allocation.
     pub fn quasi_static(&self, rotation: &Matrix3<f64>, a: &[f64]) -> f64 {
@@ -202,23 +220,23 @@ impl LowestModes {
     }
 
     /// The elastic displacement relative to the supports (relative to the nearest rigid motion
-    /// on a body without supports) from the local deformation `ū` and its elastic force
-    /// `g = K ū` (flat `3N`, co-moving frame): the mass-weighted RMS of its part in the lowest
-    /// modes and a bound of the rest's (m).
+    /// on a body without supports) from the elastic force `g = K ū` of the local deformation
+    /// `ū` (flat `3N`, co-moving frame) and twice the strain energy, `energy` (J: `ūᵀ g` with one
+    /// frame): the mass-weighted RMS of its part in the lowest modes and a bound of the rest's
+    /// (m).
     ///
     /// `K` does not see the rigid motion by which `ū` (measured in the best-fit frame) differs
     /// from the displacement `u` relative to the supports, so `g = K u` and the modal
     /// coordinates are `q_j = φ_jᵀ M u = φ_jᵀ g / ω_j²` (on the free nodes `K_FF u_F = g_F`).
     /// The rest carries the energy `ūᵀ g − Σ_j ω_j² q_j²` in modes at or above `ω_top`, so its
     /// mass norm squared is at most that over `ω_top²`. No allocation.
-    pub fn deformation(&self, local_deformation: &[f64], elastic_force: &[f64]) -> (f64, f64) {
+    pub fn deformation(&self, energy: f64, elastic_force: &[f64]) -> (f64, f64) {
         let p = self.project(&self.modes, &Matrix3::identity(), elastic_force);
         let (mut low, mut low_energy) = (0.0, 0.0);
         for (p, &w2) in p.iter().zip(&self.omega_sq) {
             low += p * p / (w2 * w2);
             low_energy += p * p / w2;
         }
-        let energy = crate::linalg::dot(local_deformation, elastic_force);
         let above = (energy - low_energy).max(0.0) / self.omega_top_sq;
         (
             (low / self.total_mass).sqrt(),
@@ -294,7 +312,7 @@ mod tests {
         // the kept ones): g = K u = (0.5, 2.4, 0 | 1, 0, 0).
         let u = [0.5, 0.3, 0.0, 0.25, 0.0, 0.0];
         let g = [0.5, 2.4, 0.0, 1.0, 0.0, 0.0];
-        let (low, above) = modes.deformation(&u, &g);
+        let (low, above) = modes.deformation(crate::linalg::dot(&u, &g), &g);
         // In the modes: q = (0.5, 0.25), RMS √(0.3125 / 2).
         assert!((low - (0.3125_f64 / 2.0).sqrt()).abs() < 1e-15);
         // Above: the energy 0.72 J over ω_top² = 4 bounds the true 0.3² = 0.09 by 0.18.

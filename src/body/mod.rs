@@ -150,6 +150,9 @@ pub struct ForceScratch {
     damping_force: Vec<f64>,
     mass_times: Vec<f64>,
     stiffening_force: Vec<f64>,
+    /// The strain energy of the last [`Body::internal_force`] call (J; NaN for the full
+    /// formulation).
+    strain_energy: f64,
     patch: Option<patches::PatchScratch>,
     /// A reduced body with patches: the expanded nodes' positions and their patch forces
     /// (flat `3N` of the mesh each).
@@ -165,6 +168,12 @@ impl ForceScratch {
     /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N).
     pub fn elastic_force(&self) -> &[f64] {
         &self.elastic_force
+    }
+
+    /// The strain energy `V` of the last [`Body::internal_force`] call (J): `½ ūᵀ K ū` with
+    /// one frame, `Σ_p ½ ū_pᵀ K_p ū_p` with patches, NaN for the full formulation.
+    pub fn strain_energy(&self) -> f64 {
+        self.strain_energy
     }
 
     /// The rotation `R_p` of patch `p` in the last [`Body::internal_force`] call (a body with
@@ -361,6 +370,7 @@ impl Body {
             damping_force: vec![0.0; n3],
             mass_times: vec![0.0; n3],
             stiffening_force: vec![0.0; n3],
+            strain_energy: 0.0,
             patch: self.patches.as_ref().map(Patches::scratch),
             expanded: self
                 .reduction
@@ -551,6 +561,7 @@ impl Body {
             }
             set_node(f, i, &global);
         }
+        scratch.strain_energy = strain_energy;
         BodyKinematics {
             frame,
             angular_velocity_body,

@@ -1,6 +1,6 @@
 //! `model.auto`: which of the allowed terms are in force, chosen per communication step.
 
-use super::assembly::Model;
+use super::assembly::{Features, Model};
 use super::{Dynamics, LogEvent};
 use crate::body::feature_indicators::{self};
 use crate::body::frame::angle_between;
@@ -317,6 +317,56 @@ pub(super) const BENDING_ERROR: f64 = 4.0;
 /// switched at the accuracy 0.65 % of the peak off `full`, at a quarter 0.24 %, at a tenth
 /// 0.23 % (the slabs alone 0.23 %).
 pub(super) const SWITCH_AT: f64 = 0.25;
+
+/// Carries the state over from the one frame to `model.auto`'s slabs just switched on (before
+/// the first internal step of `h` of the communication step where they came on; `old`: the
+/// terms in force before it): the one frame's internal force at the state (`old_force`, scratch
+/// of `3N`) against the slabs' ([`crate::solver::integrator::TimeIntegrator::carry_over_force_change`]).
+/// The one frame's state balances its own linear strain of the slabs' turns `θ`, an axial
+/// stretch of about `θ²/2` that the slabs do not have: put in place as it is, the slabs spring
+/// back from it at the stiff modes' periods (docs/formulation.md, "The slabs' switch"). Returns
+/// the largest position change (m).
+pub(super) fn carry_over_to_slabs(
+    model: &mut Model,
+    dynamics: &mut Dynamics,
+    h: f64,
+    old: Features,
+    old_force: &mut [f64],
+    tolerance: f64,
+) -> Option<f64> {
+    let slabs = dynamics.features;
+    let one_frame = Features {
+        frames: false,
+        stiffening: old.stiffening,
+        ..slabs
+    };
+    model.apply_features(one_frame);
+    model
+        .forces
+        .observe(&model.body, &dynamics.state, old_force);
+    model.apply_features(slabs);
+    let rotation = model
+        .body
+        .frame_weights
+        .best_fit(&dynamics.state.position)
+        .rotation;
+    let modes = model.lowest_modes.as_ref();
+    let remove_lowest = |v: &mut [f64]| {
+        if let Some(modes) = modes {
+            modes.remove_lowest(&rotation, v);
+        }
+    };
+    model.integrator.carry_over_force_change(
+        h,
+        &model.body,
+        &model.free,
+        &mut dynamics.state,
+        &mut model.forces,
+        old_force,
+        &remove_lowest,
+        tolerance,
+    )
+}
 
 /// `model.auto`'s slabs (one co-moving frame per element layer along the body's long axis,
 /// `Patches::element_layers`): switched on, once and for good, at the first communication

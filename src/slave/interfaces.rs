@@ -327,8 +327,7 @@ impl Slave {
                             self.driving[k].updated_at = t;
                             continue;
                         }
-                        jumped = true;
-                        motion_jumped = true;
+                        let followed = old.rate_span > 0.0;
                         // The velocities' mean rates since they were last given
                         // (`DrivingFrame`); followed when they are samples of a smooth motion:
                         // they changed at the update before too (not a step of the velocity
@@ -343,6 +342,15 @@ impl Slave {
                             if !calm && follows_rates(&old, &frame, since, self.size) {
                                 frame.rate_span = since;
                             }
+                        }
+                        // A sampled smooth motion that goes on along its rates (followed up to
+                        // this update and from it) bends the held path by the rates' change,
+                        // `O(H²)` in the velocity and `O(H³)` in the pose: no jump, its steps
+                        // are estimated like any other (docs/fmu.md, "Inputs are samples in
+                        // time").
+                        if !(followed && frame.rate_span > 0.0) {
+                            jumped = true;
+                            motion_jumped = true;
                         }
                     }
                     self.driving[k] = frame;

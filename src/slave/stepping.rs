@@ -1,7 +1,8 @@
 //! `fmi2DoStep`: a communication step as internal steps, with halving retries and rollback.
 
 use super::auto_features::{
-    choose_driven_stiffening, choose_features, linear_reach_exceeded, LINEAR_AT, NOT_QUIET,
+    carry_over_to_slabs, choose_driven_stiffening, choose_features, linear_reach_exceeded,
+    LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -111,6 +112,20 @@ impl Slave {
                 break Err(e);
             }
             backed_up = true;
+            let dynamics = self.dynamics.as_mut().unwrap();
+            let model = self.model.as_mut().unwrap();
+            if dynamics.features.frames && !slabs_before && model.allowed.frames {
+                // model.auto's slabs came on at this communication point: the state is carried
+                // over to them (each attempt from the backup, which holds the one frame's).
+                carry_over_to_slabs(
+                    model,
+                    dynamics,
+                    h,
+                    before.features,
+                    &mut self.scale_scratch,
+                    self.parameters.tolerance * self.size,
+                );
+            }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
             if controlled && (n > 1 || !self.inputs_jumped) {
@@ -185,23 +200,13 @@ impl Slave {
                 // The ratio falls like h² (4× per rung): one that fell by less than 2 is the
                 // iteration's noise, or a ringing the step does not resolve, whose filtered
                 // estimate is about its amplitude: below half the budget `ε D`, its error (at
-                // most twice its amplitude) is within it either way. In the communication step
-                // where model.auto's slabs came on, less than 2 per rung refined: the switch
-                // rings the body, resolved on the finer rungs, and that ringing is the model
-                // change's, not the time step's (docs/formulation.md, "Known cost: the slabs'
-                // switch"). Not elsewhere: a ringing that falls only once it is resolved is the
-                // time step's (B1's beam pulled by 10 kN ended 8 % off at 1e-2 with that rule).
+                // most twice its amplitude) is within it either way. (Not a ringing that falls
+                // only once it is resolved: that is the time step's.)
                 let dynamics = self.dynamics.as_ref().unwrap();
                 let budget = self.parameters.accuracy * dynamics.deformation_scale;
-                let switched = dynamics.features.frames && !slabs_before;
-                let fall = if switched {
-                    f64::from(1u32 << (level - coarser))
-                } else {
-                    2.0
-                };
                 if result.is_ok()
                     && ratio > 1.0
-                    && ratio >= estimate / fall
+                    && ratio >= estimate / 2.0
                     && self.step_estimate <= 0.5 * budget
                 {
                     // Refining did not reduce the estimate: what is left is no error of the time
@@ -561,7 +566,7 @@ impl Slave {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled: B3 driven at a 10 ms communication step ends 1.8e-3 of its peak from the converged response at model.accuracy = 1e-3. A shorter communication step reduces it, and so does solver.stepSize below the communication step, whose internal steps it then fixes (B3 with solver.stepSize = 5e-3: 6.0e-4; docs/formulation.md, \"Time error control\"); the run summary counts these steps"
+                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled (a motion sampled with its velocities is estimated once they change from update to update and the poses follow them: docs/fmu.md, \"Inputs are samples in time\"). A shorter communication step reduces it, and so does solver.stepSize below the communication step, whose internal steps it then fixes (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
                 ),
             });
         }

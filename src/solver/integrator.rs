@@ -241,6 +241,40 @@ impl TimeIntegrator {
         }
     }
 
+    /// Carries `state` over to a change of the internal force at it, from `old_force` to
+    /// `body`'s ([`generalized_alpha::carry_over_force_change`], with the iteration matrix of
+    /// `h`, prepared): the largest position change (m). The other schemes take the state as it
+    /// is (`None`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn carry_over_force_change(
+        &mut self,
+        h: f64,
+        body: &Body,
+        free: &FreeNodes,
+        state: &mut DynamicState,
+        forces: &mut ResidualWorkspace,
+        old_force: &[f64],
+        remove_lowest: &dyn Fn(&mut [f64]),
+        tolerance: f64,
+    ) -> Option<f64> {
+        match self {
+            TimeIntegrator::GeneralizedAlpha {
+                cache, workspace, ..
+            } => Some(generalized_alpha::carry_over_force_change(
+                body,
+                free,
+                cache.get_mut(h),
+                state,
+                workspace,
+                forces,
+                old_force,
+                remove_lowest,
+                tolerance,
+            )),
+            _ => None,
+        }
+    }
+
     /// The step sizes with a factorization, most recently used last.
     pub fn cached_step_sizes(&self) -> Vec<f64> {
         match self {

@@ -1,0 +1,79 @@
+//! A change of the elastic force at one state (`model.auto`'s slabs put in place of the one
+//! co-moving frame): the state carried over to the new force without setting the modes above
+//! the lowest ringing (docs/formulation.md, "The slabs' switch").
+
+use super::{IterationMatrix, StepWorkspace};
+use crate::body::Body;
+use crate::solver::problem::{DynamicState, FreeNodes, ResidualWorkspace};
+
+/// Most corrections of [`carry_over_force_change`]: each takes a mode's remaining shift by the
+/// factor `c_m / (ω² + c_m)`, so the modes well above `√c_m` are done in a few and the ones
+/// near the lowest kept modes in a few dozen.
+pub const MAX_CORRECTIONS: usize = 50;
+
+/// Carries `state` over from the internal force `old_force` (flat `3N`: `f_old(x, ẋ)` of the
+/// model before the change, at this state) to `body`'s current one, `f_new`: the positions of
+/// the free nodes move by the static response `δ` to the force difference in every mode but
+/// the lowest, so that `f_new(x + δ, ẋ) − f_old` has no part above them:
+///
+/// `δ ← δ − P S⁻¹ (f_new(x + δ, ẋ) − f_old)`, with the iteration matrix `S` of the next step
+/// (`hR (c_m M + c_d D + K) hRᵀ`) and `P` = `remove_lowest`, which takes a field's part in the
+/// lowest modes out (flat `3N`, global), until a correction is below `tolerance` (m) or after
+/// [`MAX_CORRECTIONS`]. The velocities, accelerations and multipliers stay: a mode above the
+/// lowest keeps its vibration about an equilibrium shifted by the two models' difference, and
+/// the lowest take that difference as a step load, as the first step's residual.
+///
+/// The two models' forces differ most in the stiff modes: the one frame's linear strain of a
+/// slab turned by `θ` against it holds a spurious `θ²/2`, an axial force `EA θ²/2`, which its
+/// state balances by a stretch the slabs do not have; put in place as it is, the slabs spring
+/// back from it at the stiff modes' periods. Returns the largest `|δ|` (m). No allocation.
+#[allow(clippy::too_many_arguments)]
+pub fn carry_over_force_change(
+    body: &Body,
+    free: &FreeNodes,
+    matrix: &mut IterationMatrix,
+    state: &mut DynamicState,
+    ws: &mut StepWorkspace,
+    forces: &mut ResidualWorkspace,
+    old_force: &[f64],
+    remove_lowest: &dyn Fn(&mut [f64]),
+    tolerance: f64,
+) -> f64 {
+    let nf3 = free.dof_count();
+    let mut largest = 0.0_f64;
+    for _ in 0..MAX_CORRECTIONS {
+        let kin = body.internal_force(
+            &state.position,
+            &state.velocity,
+            forces.geometric_stiffness.as_ref(),
+            &mut forces.force_scratch,
+            &mut forces.internal,
+        );
+        for (r, old) in forces.internal.iter_mut().zip(old_force) {
+            *r -= old;
+        }
+        // The plain update solves `S ỹ = r` and sets the multipliers of that residual alone:
+        // they are put back (the iterate holds them).
+        matrix.plain_update(body, free, &kin.frame.rotation, state, ws, forces);
+        state.multipliers.copy_from_slice(&ws.iterate[nf3..]);
+        let correction = &mut forces.external;
+        correction.fill(0.0);
+        for (k, &i) in free.nodes.iter().enumerate() {
+            correction[3 * i..3 * i + 3].copy_from_slice(&ws.update[3 * k..3 * k + 3]);
+        }
+        remove_lowest(correction);
+        let mut change = 0.0_f64;
+        for &i in &free.nodes {
+            let moved = &correction[3 * i..3 * i + 3];
+            for (x, dx) in state.position[3 * i..3 * i + 3].iter_mut().zip(moved) {
+                *x += dx;
+                change = change.max(dx.abs());
+            }
+        }
+        largest = largest.max(change);
+        if change <= tolerance {
+            break;
+        }
+    }
+    largest
+}
