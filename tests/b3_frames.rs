@@ -141,7 +141,10 @@ fn model_auto_takes_slabs_once_b3_bends_far() {
     for m in &log {
         println!("{m}");
     }
-    let switches: Vec<&String> = log.iter().filter(|m| m.contains("slabs")).collect();
+    let switches: Vec<&String> = log
+        .iter()
+        .filter(|m| m.contains("slabs, one per element layer"))
+        .collect();
     assert_eq!(switches.len(), 1, "{log:?}");
     let t: f64 = switches[0]["model.auto: at t = ".len()..]
         .split(' ')
@@ -150,6 +153,14 @@ fn model_auto_takes_slabs_once_b3_bends_far() {
         .parse()
         .unwrap();
     assert!((2.0..9.0).contains(&t), "slabs at t = {t} s");
+    // The state carried over to them, once (docs/formulation.md, "The slabs' switch").
+    assert_eq!(
+        log.iter()
+            .filter(|m| m.contains("carried over to the slabs"))
+            .count(),
+        1,
+        "{log:?}"
+    );
     let (e_one, e_auto) = (deviation(&one, &full), deviation(&auto, &full));
     println!(
         "deviation from full over {end} s: one frame {:.3} %, model.auto {:.3} %",

@@ -6,6 +6,7 @@ use crate::body::feature_indicators::{self};
 use crate::body::frame::angle_between;
 use crate::body::lowest_modes::MODES;
 use crate::model::category;
+use crate::solver::generalized_alpha::Carried;
 
 /// `Dynamics::quiet_since` of a term whose indicator is not below its switch-off threshold (a
 /// finite number: the state's byte form holds finite numbers only).
@@ -324,8 +325,9 @@ pub(super) const SWITCH_AT: f64 = 0.25;
 /// of `3N`) against the slabs' ([`crate::solver::integrator::TimeIntegrator::carry_over_force_change`]).
 /// The one frame's state balances its own linear strain of the slabs' turns `θ`, an axial
 /// stretch of about `θ²/2` that the slabs do not have: put in place as it is, the slabs spring
-/// back from it at the stiff modes' periods (docs/formulation.md, "The slabs' switch"). Returns
-/// the largest position change (m).
+/// back from it at the stiff modes' periods (docs/formulation.md, "The slabs' switch"). `None`
+/// (the state as it is) on a body with pins, hinges or rigid sets, whose lowest modes do not
+/// see the constraints, or without the lowest modes (no error control).
 pub(super) fn carry_over_to_slabs(
     model: &mut Model,
     dynamics: &mut Dynamics,
@@ -333,14 +335,15 @@ pub(super) fn carry_over_to_slabs(
     old: Features,
     old_force: &mut [f64],
     tolerance: f64,
-) -> Option<f64> {
+) -> Option<Carried> {
+    if model.free.is_constrained() || model.lowest_modes.is_none() {
+        return None;
+    }
     let slabs = dynamics.features;
-    let one_frame = Features {
+    model.apply_features(Features {
         frames: false,
-        stiffening: old.stiffening,
-        ..slabs
-    };
-    model.apply_features(one_frame);
+        ..old
+    });
     model
         .forces
         .observe(&model.body, &dynamics.state, old_force);
@@ -350,12 +353,8 @@ pub(super) fn carry_over_to_slabs(
         .frame_weights
         .best_fit(&dynamics.state.position)
         .rotation;
-    let modes = model.lowest_modes.as_ref();
-    let remove_lowest = |v: &mut [f64]| {
-        if let Some(modes) = modes {
-            modes.remove_lowest(&rotation, v);
-        }
-    };
+    let modes = model.lowest_modes.as_ref()?;
+    let remove_lowest = |v: &mut [f64]| modes.remove_lowest(&rotation, v);
     model.integrator.carry_over_force_change(
         h,
         &model.body,
@@ -374,8 +373,8 @@ pub(super) fn carry_over_to_slabs(
 /// gradient of the local deformation) exceeds [`SWITCH_AT`] × `model.accuracy`; logged. They are not switched off: the two models' elastic forces differ
 /// by the single frame's artefact, and dropping the slabs applies that difference as a step
 /// load (on B3, slabs from 4 s to 10 s ended 7.1 % off `full` against 0.57 % when kept).
-/// Switching needs no state transfer (the state is nodal positions) and no factorization (the
-/// constant iteration matrix holds the same `K`). If a communication step does not converge
+/// Switching needs no factorization (the constant iteration matrix holds the same `K`); the
+/// state is carried over to the slabs ([`carry_over_to_slabs`]). If a communication step does not converge
 /// with the slabs on (just switched on, or later as the body goes on bending violently),
 /// `Slave::do_step` redoes it with the one frame and the slabs are not tried again (B1 under
 /// 5 kN, far beyond small strain).

@@ -41,6 +41,10 @@ pub(super) struct LastStep {
     pub(super) step: f64,
     pub(super) start: f64,
     pub(super) length: f64,
+    /// The terms in force before the step, if `model.auto`'s slabs came on at its start: the
+    /// redo carries the state over to them as the step did
+    /// ([`super::auto_features::carry_over_to_slabs`]).
+    pub(super) slabs_from: Option<super::assembly::Features>,
 }
 
 /// The inputs a communication step was taken with: the inputs, their derivatives, how old
@@ -247,6 +251,18 @@ impl Slave {
             dynamics
                 .state
                 .copy_from(self.backup.as_ref().expect("a step was taken"));
+            if let Some(old) = last.slabs_from {
+                // The inputs do not enter the carry-over (the state at the step's start): the
+                // perturbations start after it.
+                super::auto_features::carry_over_to_slabs(
+                    self.model.as_mut().unwrap(),
+                    dynamics,
+                    last.step,
+                    old,
+                    &mut self.scale_scratch,
+                    self.parameters.tolerance * self.size,
+                );
+            }
         }
         let counters = (
             self.statistics,

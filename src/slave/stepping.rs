@@ -102,6 +102,8 @@ impl Slave {
         // The rung and the error ratio of the first attempt that was refined.
         let mut refined_from: Option<(u32, f64)> = None;
         let mut taken = (0, 0.0);
+        // The slabs' carry-over is logged once, not per attempt.
+        let mut carry_over_logged = false;
         let result = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
                 Ok(step) => step,
@@ -117,14 +119,31 @@ impl Slave {
             if dynamics.features.frames && !slabs_before && model.allowed.frames {
                 // model.auto's slabs came on at this communication point: the state is carried
                 // over to them (each attempt from the backup, which holds the one frame's).
-                carry_over_to_slabs(
+                let tolerance = self.parameters.tolerance * self.size;
+                let carried = carry_over_to_slabs(
                     model,
                     dynamics,
                     h,
                     before.features,
                     &mut self.scale_scratch,
-                    self.parameters.tolerance * self.size,
+                    tolerance,
                 );
+                if let Some(c) = carried.filter(|_| !carry_over_logged) {
+                    carry_over_logged = true;
+                    self.events.push(LogEvent {
+                        category: category::EVENTS,
+                        message: format!(
+                            "model.auto: at t = {t0} the state is carried over to the slabs: the free nodes moved by up to {:.3e} m in {} corrections (the static response to the two models' force difference above the lowest modes){}",
+                            c.largest,
+                            c.corrections,
+                            if c.last > tolerance {
+                                format!("; the last, {:.3e} m, is above the iteration's tolerance {tolerance:.3e} m", c.last)
+                            } else {
+                                String::new()
+                            }
+                        ),
+                    });
+                }
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -305,11 +324,15 @@ impl Slave {
                         ),
                     });
                 }
+                let slabs_came_on = dynamics.features.frames
+                    && !slabs_before
+                    && self.model.as_ref().unwrap().allowed.frames;
                 self.jacobian_step = Some(super::step_jacobian::LastStep {
                     steps: taken.0,
                     step: taken.1,
                     start: t0,
                     length: big_h,
+                    slabs_from: slabs_came_on.then_some(before.features),
                 });
                 dynamics.ladder = if probing && self.step_error.is_none() {
                     // Not estimated after all: back on the rung it probed from.

@@ -39,7 +39,7 @@ mod model_change;
 pub mod sensitivity;
 mod step_change;
 pub use consistent::{initial_acceleration, restart_for_load_change};
-pub use model_change::carry_over_force_change;
+pub use model_change::{carry_over_force_change, Carried};
 
 /// Generalized-α coefficients from the spectral radius at infinite frequency `ρ∞ ∈ [0, 1]`:
 /// `α_m = (2ρ∞ − 1)/(ρ∞ + 1)`, `α_f = ρ∞/(ρ∞ + 1)`, `γ = ½ − α_m + α_f`, `β = ¼ (1 − α_m + α_f)²`

@@ -243,8 +243,8 @@ impl TimeIntegrator {
 
     /// Carries `state` over to a change of the internal force at it, from `old_force` to
     /// `body`'s ([`generalized_alpha::carry_over_force_change`], with the iteration matrix of
-    /// `h`, prepared): the largest position change (m). The other schemes take the state as it
-    /// is (`None`).
+    /// `h`, prepared; unconstrained bodies). The other schemes take the state as it is
+    /// (`None`).
     #[allow(clippy::too_many_arguments)]
     pub fn carry_over_force_change(
         &mut self,
@@ -256,7 +256,7 @@ impl TimeIntegrator {
         old_force: &[f64],
         remove_lowest: &dyn Fn(&mut [f64]),
         tolerance: f64,
-    ) -> Option<f64> {
+    ) -> Option<generalized_alpha::Carried> {
         match self {
             TimeIntegrator::GeneralizedAlpha {
                 cache, workspace, ..

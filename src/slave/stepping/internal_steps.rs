@@ -338,7 +338,9 @@ pub(super) fn observe_deformation(
     // With patches the strain energy is theirs: the one frame's `ūᵀ K ū` holds its own
     // spurious strain of the slabs' turns (`θ²/2`, axial), an energy in the stiff modes that
     // the body does not have, which made the modes above the lowest look large enough to
-    // control (docs/formulation.md, "Time error control").
+    // control (docs/formulation.md, "Time error control"). The lowest modes' part still comes
+    // from the one frame's `K ū`: a bound of mixed origin, the rest taken as 0 where that part
+    // exceeds the frames' energy.
     let energy = if body.patches.is_some() {
         2.0 * scratch.strain_energy()
     } else {

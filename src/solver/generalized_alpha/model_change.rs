@@ -26,7 +26,12 @@ pub const MAX_CORRECTIONS: usize = 50;
 /// The two models' forces differ most in the stiff modes: the one frame's linear strain of a
 /// slab turned by `θ` against it holds a spurious `θ²/2`, an axial force `EA θ²/2`, which its
 /// state balances by a stretch the slabs do not have; put in place as it is, the slabs spring
-/// back from it at the stiff modes' periods. Returns the largest `|δ|` (m). No allocation.
+/// back from it at the stiff modes' periods. Returns the largest correction (m), the number
+/// of corrections and whether the last was below `tolerance`. No allocation.
+///
+/// Unconstrained bodies only (no pins, hinges or rigid sets): the lowest modes are those of the
+/// free DOFs without the constraints, so taking them out of a correction would leave the
+/// constraints (and a hinge's free turn is no mode at all).
 #[allow(clippy::too_many_arguments)]
 pub fn carry_over_force_change(
     body: &Body,
@@ -38,9 +43,14 @@ pub fn carry_over_force_change(
     old_force: &[f64],
     remove_lowest: &dyn Fn(&mut [f64]),
     tolerance: f64,
-) -> f64 {
+) -> Carried {
+    debug_assert!(!free.is_constrained());
     let nf3 = free.dof_count();
-    let mut largest = 0.0_f64;
+    let mut carried = Carried {
+        largest: 0.0,
+        last: 0.0,
+        corrections: 0,
+    };
     for _ in 0..MAX_CORRECTIONS {
         let kin = body.internal_force(
             &state.position,
@@ -70,10 +80,20 @@ pub fn carry_over_force_change(
                 change = change.max(dx.abs());
             }
         }
-        largest = largest.max(change);
+        carried.largest = carried.largest.max(change);
+        carried.last = change;
+        carried.corrections += 1;
         if change <= tolerance {
             break;
         }
     }
-    largest
+    carried
+}
+
+/// What [`carry_over_force_change`] did: the largest correction and the last (m), and how many.
+#[derive(Debug, Clone, Copy)]
+pub struct Carried {
+    pub largest: f64,
+    pub last: f64,
+    pub corrections: usize,
 }
