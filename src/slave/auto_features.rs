@@ -327,7 +327,9 @@ pub(super) const SWITCH_AT: f64 = 0.25;
 /// stretch of about `θ²/2` that the slabs do not have: put in place as it is, the slabs spring
 /// back from it at the stiff modes' periods (docs/formulation.md, "The slabs' switch"). `None`
 /// (the state as it is) on a body with pins, hinges or rigid sets, whose lowest modes do not
-/// see the constraints, or without the lowest modes (no error control).
+/// see the constraints, or without the lowest modes (no error control). With `events`, what it
+/// did is logged there.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn carry_over_to_slabs(
     model: &mut Model,
     dynamics: &mut Dynamics,
@@ -335,6 +337,7 @@ pub(super) fn carry_over_to_slabs(
     old: Features,
     old_force: &mut [f64],
     tolerance: f64,
+    events: Option<&mut Vec<LogEvent>>,
 ) -> Option<Carried> {
     if model.free.is_constrained() || model.lowest_modes.is_none() {
         return None;
@@ -355,7 +358,7 @@ pub(super) fn carry_over_to_slabs(
         .rotation;
     let modes = model.lowest_modes.as_ref()?;
     let remove_lowest = |v: &mut [f64]| modes.remove_lowest(&rotation, v);
-    model.integrator.carry_over_force_change(
+    let carried = model.integrator.carry_over_force_change(
         h,
         &model.body,
         &model.free,
@@ -364,7 +367,27 @@ pub(super) fn carry_over_to_slabs(
         old_force,
         &remove_lowest,
         tolerance,
-    )
+    )?;
+    if let Some(events) = events {
+        events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "model.auto: at t = {} the state is carried over to the slabs: the free nodes moved by up to {:.3e} m in {} corrections (the static response to the two models' force difference above the lowest modes){}",
+                dynamics.state.time,
+                carried.largest,
+                carried.corrections,
+                if carried.last > tolerance {
+                    format!(
+                        "; the last, {:.3e} m, is above the iteration's tolerance {tolerance:.3e} m",
+                        carried.last
+                    )
+                } else {
+                    String::new()
+                }
+            ),
+        });
+    }
+    Some(carried)
 }
 
 /// `model.auto`'s slabs (one co-moving frame per element layer along the body's long axis,

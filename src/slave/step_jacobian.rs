@@ -261,6 +261,7 @@ impl Slave {
                     old,
                     &mut self.scale_scratch,
                     self.parameters.tolerance * self.size,
+                    None,
                 );
             }
         }

@@ -119,31 +119,16 @@ impl Slave {
             if dynamics.features.frames && !slabs_before && model.allowed.frames {
                 // model.auto's slabs came on at this communication point: the state is carried
                 // over to them (each attempt from the backup, which holds the one frame's).
-                let tolerance = self.parameters.tolerance * self.size;
-                let carried = carry_over_to_slabs(
+                carry_over_to_slabs(
                     model,
                     dynamics,
                     h,
                     before.features,
                     &mut self.scale_scratch,
-                    tolerance,
+                    self.parameters.tolerance * self.size,
+                    (!carry_over_logged).then_some(&mut self.events),
                 );
-                if let Some(c) = carried.filter(|_| !carry_over_logged) {
-                    carry_over_logged = true;
-                    self.events.push(LogEvent {
-                        category: category::EVENTS,
-                        message: format!(
-                            "model.auto: at t = {t0} the state is carried over to the slabs: the free nodes moved by up to {:.3e} m in {} corrections (the static response to the two models' force difference above the lowest modes){}",
-                            c.largest,
-                            c.corrections,
-                            if c.last > tolerance {
-                                format!("; the last, {:.3e} m, is above the iteration's tolerance {tolerance:.3e} m", c.last)
-                            } else {
-                                String::new()
-                            }
-                        ),
-                    });
-                }
+                carry_over_logged = true;
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
