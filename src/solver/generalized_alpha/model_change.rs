@@ -26,8 +26,8 @@ pub const MAX_CORRECTIONS: usize = 50;
 /// The two models' forces differ most in the stiff modes: the one frame's linear strain of a
 /// slab turned by `θ` against it holds a spurious `θ²/2`, an axial force `EA θ²/2`, which its
 /// state balances by a stretch the slabs do not have; put in place as it is, the slabs spring
-/// back from it at the stiff modes' periods. Returns the largest correction (m), the number
-/// of corrections and whether the last was below `tolerance`. No allocation.
+/// back from it at the stiff modes' periods. Returns the largest and the last correction (m)
+/// and their number. No allocation.
 ///
 /// Unconstrained bodies only (no pins, hinges or rigid sets): the lowest modes are those of the
 /// free DOFs without the constraints, so taking them out of a correction would leave the
@@ -45,7 +45,6 @@ pub fn carry_over_force_change(
     tolerance: f64,
 ) -> Carried {
     debug_assert!(!free.is_constrained());
-    let nf3 = free.dof_count();
     let mut carried = Carried {
         largest: 0.0,
         last: 0.0,
@@ -62,10 +61,8 @@ pub fn carry_over_force_change(
         for (r, old) in forces.internal.iter_mut().zip(old_force) {
             *r -= old;
         }
-        // The plain update solves `S ỹ = r` and sets the multipliers of that residual alone:
-        // they are put back (the iterate holds them).
+        // (The body has no multipliers for the plain update to set.)
         matrix.plain_update(body, free, &kin.frame.rotation, state, ws, forces);
-        state.multipliers.copy_from_slice(&ws.iterate[nf3..]);
         let correction = &mut forces.external;
         correction.fill(0.0);
         for (k, &i) in free.nodes.iter().enumerate() {
