@@ -356,7 +356,7 @@ pub(super) fn carry_over_to_slabs(
         .frame_weights
         .best_fit(&dynamics.state.position)
         .rotation;
-    let modes = model.lowest_modes.as_ref()?;
+    let modes = model.lowest_modes.as_ref().expect("checked above");
     let remove_lowest = |v: &mut [f64]| modes.remove_lowest(&rotation, v);
     let carried = model.integrator.carry_over_force_change(
         h,

@@ -103,7 +103,8 @@ impl Slave {
         let mut refined_from: Option<(u32, f64)> = None;
         let mut taken = (0, 0.0);
         // The slabs' carry-over is logged once, not per attempt.
-        let (mut carry_over_logged, mut switch_rings) = (false, false);
+        // Whether model.auto's slabs came on at this communication point (in this attempt).
+        let (mut carry_over_logged, mut switch_rings, mut slabs_came_on) = (false, false, false);
         let result = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
                 Ok(step) => step,
@@ -116,7 +117,8 @@ impl Slave {
             backed_up = true;
             let dynamics = self.dynamics.as_mut().unwrap();
             let model = self.model.as_mut().unwrap();
-            if dynamics.features.frames && !slabs_before && model.allowed.frames {
+            slabs_came_on = dynamics.features.frames && !slabs_before && model.allowed.frames;
+            if slabs_came_on {
                 // model.auto's slabs came on at this communication point: the state is carried
                 // over to them (each attempt from the backup, which holds the one frame's).
                 // A body it cannot carry over (pins, hinges, rigid sets) rings.
@@ -315,9 +317,6 @@ impl Slave {
                         ),
                     });
                 }
-                let slabs_came_on = dynamics.features.frames
-                    && !slabs_before
-                    && self.model.as_ref().unwrap().allowed.frames;
                 self.jacobian_step = Some(super::step_jacobian::LastStep {
                     steps: taken.0,
                     step: taken.1,
