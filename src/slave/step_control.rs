@@ -48,7 +48,9 @@
 //! waits too ([`Ladder::may_grow`]). Without that, an estimate that does not fall like `h²`
 //! between two rungs made the body grow, fail and redo at every communication step (B3 at
 //! `model.accuracy = 1e-3` in its steady spin: 1.74 × the allowance on the rung above, 0.005 ×
-//! on its own, 495 communication steps redone).
+//! on its own, 495 communication steps redone). Such a refinement is redone on the rung the
+//! step grew from ([`Ladder::redo_level`]), not as far down as the ratio would ask: that rung's
+//! steps were quiet, and the ratio between the two rungs is what did not fall like `h²`.
 
 /// The floor of the allowance in units of the iteration's tolerance `solver.tolerance × size`:
 /// the estimate's noise from the iteration is below 0.4 of that (see the module documentation).
@@ -228,6 +230,20 @@ impl Ladder {
         }
     }
 
+    /// The rung a communication step rejected on rung `level` with `e / allowance = ratio`
+    /// (> 1) is redone on. On a rung reached by growth or a kept probe and not yet confirmed,
+    /// the rung it came from, whose steps were quiet; elsewhere [`finer_level`]: the ratio
+    /// between two rungs need not fall like `h²` (B3 at `model.accuracy = 1e-3` at 13.8 s:
+    /// 0.12 of the allowance on 2.5 ms, 2.3 × on 5 ms, which [`finer_level`] took two rungs
+    /// down, to 1.25 ms, for the 2.5 s its calm steps took to grow back).
+    pub fn redo_level(&self, level: u32, ratio: f64) -> u32 {
+        if self.probed && level == self.level && level < MAX_LEVEL {
+            level + 1
+        } else {
+            finer_level(level, ratio)
+        }
+    }
+
     /// After a probe from this rung that failed: the same rung, the next probe twice as far off.
     pub fn after_failed_probe(self) -> Ladder {
         Ladder {
@@ -337,6 +353,11 @@ mod tests {
         assert!(fresh.may_grow());
         let grown = fresh.after_growth(2);
         assert!(grown.probed && grown.probe_after == PROBE_FIRST);
+        // A failure on it goes back to the rung it grew from, however far the ratio would ask;
+        // on a confirmed rung the ratio decides.
+        assert_eq!(grown.redo_level(2, 2.31), 3);
+        assert_eq!(fresh.redo_level(3, 2.31), finer_level(3, 2.31));
+        assert_eq!(finer_level(3, 2.31), 5);
         let mut back = grown.after_refinement(3);
         assert_eq!(back.probe_after, 2 * PROBE_FIRST);
         for _ in 0..PROBE_FIRST {

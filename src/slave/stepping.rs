@@ -6,8 +6,8 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    finer_level, rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS,
-    NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
+    rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS, NOISE_MARGIN,
+    UNESTIMATED_WARN_AFTER,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
@@ -252,7 +252,7 @@ impl Slave {
                 let finer = if probing {
                     ladder.level
                 } else {
-                    finer_level(level, ratio.max(self.step_error_unfloored))
+                    ladder.redo_level(level, ratio.max(self.step_error_unfloored))
                 };
                 self.rejected += 1;
                 self.events.push(LogEvent {
