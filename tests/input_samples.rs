@@ -15,7 +15,7 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 fn whole_and_split(
     settings: &[(&str, f64)],
     steps: usize,
-    mut each: impl FnMut(&mut flexbody::slave::Slave, f64, f64, f64),
+    mut each: impl FnMut(&mut flexbody::slave::Slave, &mut flexbody::slave::Slave, f64, f64, f64),
 ) -> (flexbody::slave::Slave, flexbody::slave::Slave) {
     let mut whole = initialized(example_body("hub_beam"), settings);
     let mut split = initialized(example_body("hub_beam"), settings);
@@ -28,7 +28,7 @@ fn whole_and_split(
         split.do_step(t, 0.5 * big_h).unwrap();
         split.do_step(t + 0.5 * big_h, 0.5 * big_h).unwrap();
         let y_split = drive.tip_deflection(&mut split, t + big_h).unwrap();
-        each(&mut split, y_split, y_whole, t);
+        each(&mut split, &mut whole, y_split, y_whole, t);
     }
     (whole, split)
 }
@@ -47,7 +47,7 @@ fn b3_with_two_steps_per_input_update_follows_b3_with_one() {
     // switch would fall on different communication points in the two runs).
     let settings = [("solver.stepSize", 5e-3), ("model.accuracy", 0.0)];
     let (mut worst, mut peak) = (0.0_f64, 0.0_f64);
-    whole_and_split(&settings, 800, |_, y_split, y_whole, _| {
+    whole_and_split(&settings, 800, |_, _, y_split, y_whole, _| {
         worst = worst.max((y_split - y_whole).abs());
         peak = peak.max(y_whole.abs());
     });
@@ -279,23 +279,30 @@ fn the_sample_times_are_part_of_the_fmu_state() {
 /// per input update and once with two half steps. The internal steps after a motion input's
 /// jump are not estimated (`MOTION_RINGING_STEPS`: the kink of the hub's sampled motion rings in
 /// the held coordinates' accelerations, which the estimate reads as error), so the split run is
-/// judged as the whole one and takes its half steps on the top rung: twice the whole run's
-/// internal steps. Before, its second half steps were estimated on that ringing: it refined to
-/// 0.16 ms at the slabs' switch and took 4 094 internal steps against 300 over these 3 s
-/// (13.6 times), and over 20 s 479 460 against 3 506.
+/// judged as the whole one: it refines no further than the whole run (2.5 ms at the slabs'
+/// switch, both) and takes at most twice its internal steps (688 against 428). Before, its
+/// second half steps were estimated on that ringing: it refined to 0.16 ms at the slabs'
+/// switch and took 4 094 internal steps against 300 over these 3 s (13.6 times), and over 20 s
+/// 479 460 against 3 506. (Its half steps then kept the top rung, 10 ms, which takes a 5 ms
+/// step whole as the 5 ms rung does: a refinement from it changed nothing, and the estimate
+/// floor took that for noise. A refinement now counts from the rung of the step taken.)
 #[test]
 fn an_importer_that_splits_steps_is_judged_as_one_that_steps_once() {
     let settings = [("model.accuracy", 1e-3)];
-    let (mut worst, mut finest) = (0.0_f64, f64::INFINITY);
-    let (whole, split) = whole_and_split(&settings, 300, |split, y_split, y_whole, _| {
+    let (mut worst, mut finest, mut finest_whole) = (0.0_f64, f64::INFINITY, f64::INFINITY);
+    let (whole, split) = whole_and_split(&settings, 300, |split, whole, y_split, y_whole, _| {
         worst = worst.max((y_split - y_whole).abs());
         finest = finest.min(split.controlled_step_size());
+        finest_whole = finest_whole.min(whole.controlled_step_size());
     });
     let (split_steps, whole_steps) = (split.solver_statistics().0, whole.solver_statistics().0);
     println!(
-        "finest rung {finest:e} s; internal steps split {split_steps}, whole {whole_steps}; largest difference {worst:.3e} m"
+        "finest rung {finest:e} s (whole steps {finest_whole:e} s); internal steps split {split_steps}, whole {whole_steps}; largest difference {worst:.3e} m"
     );
-    assert_eq!(finest, 1e-2, "the split run left the top rung");
+    assert!(
+        finest >= finest_whole,
+        "the split run refined further than the whole one"
+    );
     // Two half steps per update, each one internal step; a few redone (the first steps, before
     // any input jumps, are estimated).
     assert!(

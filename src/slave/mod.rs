@@ -183,6 +183,9 @@ pub struct Slave {
     /// jump, `step_control::UNESTIMATED_WARN_AFTER`): in all, in a row, and whether the body
     /// has warned of them.
     unestimated: (u64, u32, bool),
+    /// Communication steps accepted on the finest rung though an internal step's estimate
+    /// exceeded its allowance, and whether the body has warned of them.
+    beyond_finest: (u64, bool),
     /// Whether the body has warned that a step was accepted on the iteration's floor rather than
     /// on `model.accuracy` (`slave::stepping::internal_steps`).
     floor_warned: bool,
@@ -300,6 +303,7 @@ impl Slave {
             retries: 0,
             rejected: 0,
             unestimated: (0, 0, false),
+            beyond_finest: (0, false),
             floor_warned: false,
             tolerance_followed: false,
             step_error: None,
@@ -490,12 +494,13 @@ impl Slave {
         self.events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "run summary: {steps} internal steps, {iterations} fixed-point iterations ({:.2} per step), {} internal steps retried with halved steps, {} communication steps redone on a finer rung by the error control (model.accuracy = {:e}), {} not estimated (one internal step from an input jump); last internal step at most {:e} s",
+                "run summary: {steps} internal steps, {iterations} fixed-point iterations ({:.2} per step), {} internal steps retried with halved steps, {} communication steps redone on a finer rung by the error control (model.accuracy = {:e}), {} not estimated (one internal step from an input jump), {} accepted on the finest rung above their allowance; last internal step at most {:e} s",
                 iterations as f64 / steps.max(1) as f64,
                 self.retries,
                 self.rejected,
                 self.parameters.accuracy,
                 self.unestimated.0,
+                self.beyond_finest.0,
                 self.controlled_step_size()
             ),
         });
@@ -521,6 +526,7 @@ impl Slave {
         self.retries = 0;
         self.rejected = 0;
         self.unestimated = (0, 0, false);
+        self.beyond_finest = (0, false);
         self.floor_warned = false;
         self.tolerance_followed = false;
         self.outputs.valid = false;

@@ -236,11 +236,14 @@ impl Ladder {
     /// between two rungs need not fall like `h²` (B3 at `model.accuracy = 1e-3` at 13.8 s:
     /// 0.12 of the allowance on 2.5 ms, 2.3 × on 5 ms, which [`finer_level`] took two rungs
     /// down, to 1.25 ms, for the 2.5 s its calm steps took to grow back).
-    pub fn redo_level(&self, level: u32, ratio: f64) -> u32 {
-        if self.probed && level == self.level && level < MAX_LEVEL {
-            level + 1
+    ///
+    /// `taken` is the rung of the internal steps the communication step took
+    /// ([`level_of_step`]), `level` or coarser ones' equal: a refinement counts from it.
+    pub fn redo_level(&self, level: u32, taken: u32, ratio: f64) -> u32 {
+        if self.probed && level == self.level {
+            (taken + 1).min(MAX_LEVEL)
         } else {
-            finer_level(level, ratio)
+            finer_level(taken, ratio)
         }
     }
 
@@ -257,6 +260,19 @@ impl Ladder {
 /// The internal step of rung `level`: `step_size / 2^level` (s).
 pub fn rung(step_size: f64, level: u32) -> f64 {
     step_size / f64::from(1u32 << level)
+}
+
+/// The finest rung whose internal steps split a communication step as steps of `h` (s) do: the
+/// largest `k ≤ MAX_LEVEL` with `rung(step_size, k) ≥ h`. Every rung longer than the
+/// communication step takes it whole: refining from one of them to another changes nothing
+/// (`solver.stepSize = 0.5 s` with 2 ms communication steps: the first seven rungs are the
+/// same 2 ms step), so a refinement and the finest rung count from this one.
+pub fn level_of_step(step_size: f64, h: f64) -> u32 {
+    let mut level = 0;
+    while level < MAX_LEVEL && rung(step_size, level + 1) >= h * (1.0 - 1e-9) {
+        level += 1;
+    }
+    level
 }
 
 /// The rung after a rejected communication step whose largest `e / allowance` was `ratio` (> 1):
@@ -355,8 +371,16 @@ mod tests {
         assert!(grown.probed && grown.probe_after == PROBE_FIRST);
         // A failure on it goes back to the rung it grew from, however far the ratio would ask;
         // on a confirmed rung the ratio decides.
-        assert_eq!(grown.redo_level(2, 2.31), 3);
-        assert_eq!(fresh.redo_level(3, 2.31), finer_level(3, 2.31));
+        assert_eq!(grown.redo_level(2, 2, 2.31), 3);
+        assert_eq!(fresh.redo_level(3, 3, 2.31), finer_level(3, 2.31));
+        // Rungs longer than the communication step take it whole: the refinement counts from
+        // the rung of the step taken.
+        assert_eq!(level_of_step(0.5, 2e-3), 7);
+        assert_eq!(level_of_step(2e-3, 2e-3), 0);
+        assert_eq!(level_of_step(2e-3, 1e-3), 1);
+        assert_eq!(level_of_step(2e-3, 2e-3 / 3.0), 1);
+        assert_eq!(level_of_step(1.0, 1e-9), MAX_LEVEL);
+        assert_eq!(fresh.redo_level(0, 7, 2.31), 8);
         assert_eq!(finer_level(3, 2.31), 5);
         let mut back = grown.after_refinement(3);
         assert_eq!(back.probe_after, 2 * PROBE_FIRST);

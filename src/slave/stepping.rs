@@ -6,8 +6,8 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS, NOISE_MARGIN,
-    UNESTIMATED_WARN_AFTER,
+    level_of_step, rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS,
+    NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
@@ -105,14 +105,16 @@ impl Slave {
         // The slabs' carry-over is logged once, not per attempt.
         // Whether model.auto's slabs came on at this communication point (in this attempt).
         let (mut carry_over_logged, mut switch_rings, mut slabs_came_on) = (false, false, false);
-        let result = loop {
+        let (result, beyond_finest) = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
                 Ok(step) => step,
-                Err(e) => break Err(e),
+                Err(e) => break (Err(e), None),
             };
             taken = (n, h);
+            // The rung of the steps taken: coarser rungs than the communication step are its.
+            let taken_level = level.max(level_of_step(self.parameters.step_size, h));
             if let Err(e) = self.prepare_step(h) {
-                break Err(e);
+                break (Err(e), None);
             }
             backed_up = true;
             let dynamics = self.dynamics.as_mut().unwrap();
@@ -145,7 +147,7 @@ impl Slave {
             let mut result = Ok(());
             for i in 0..n {
                 result = self.internal_step(t0, big_h, i, n, h);
-                let redo = self.step_error.is_some_and(|r| r > 1.0) && level < MAX_LEVEL;
+                let redo = self.step_error.is_some_and(|r| r > 1.0) && taken_level < MAX_LEVEL;
                 if result.is_err() || redo {
                     break;
                 }
@@ -215,7 +217,13 @@ impl Slave {
                 // the time step's (B1's beam pulled by 10 kN ended 8 % off at 1e-2 with it).
                 let dynamics = self.dynamics.as_ref().unwrap();
                 let budget = self.parameters.accuracy * dynamics.deformation_scale;
-                let fall = f64::from(1u32 << if switch_rings { level - coarser } else { 1 });
+                let fall = f64::from(
+                    1u32 << if switch_rings {
+                        taken_level - coarser
+                    } else {
+                        1
+                    },
+                );
                 if result.is_ok()
                     && ratio > 1.0
                     && ratio >= estimate / fall
@@ -243,7 +251,7 @@ impl Slave {
                     continue;
                 }
             }
-            if result.is_ok() && ratio > 1.0 && level < MAX_LEVEL {
+            if result.is_ok() && ratio > 1.0 && taken_level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
                 // control"), a probe on the rung it came from; as far down as the accuracy asks:
                 // a step rejected on the iteration's floor has an estimate above that floor,
@@ -252,7 +260,7 @@ impl Slave {
                 let finer = if probing {
                     ladder.level
                 } else {
-                    ladder.redo_level(level, ratio.max(self.step_error_unfloored))
+                    ladder.redo_level(level, taken_level, ratio.max(self.step_error_unfloored))
                 };
                 self.rejected += 1;
                 self.events.push(LogEvent {
@@ -275,7 +283,7 @@ impl Slave {
                 dynamics.state.copy_from(backup);
                 before.restore_scales(dynamics);
                 if !probing && refined_from.is_none() {
-                    refined_from = Some((level, ratio));
+                    refined_from = Some((taken_level, ratio));
                 }
                 level = finer;
                 if probing {
@@ -284,7 +292,9 @@ impl Slave {
                 }
                 continue;
             }
-            break result;
+            // Kept with its estimate above the allowance: only on the finest rung.
+            let beyond_finest = (result.is_ok() && ratio > 1.0).then_some((h, ratio));
+            break (result, beyond_finest);
         };
         let dynamics = self.dynamics.as_mut().unwrap();
         let result = result.and_then(|()| {
@@ -349,6 +359,9 @@ impl Slave {
                 dynamics.ladder.sampled_motion = ladder.sampled_motion;
                 if controlled {
                     self.count_unestimated(t0 + big_h, taken.1);
+                }
+                if let Some((h, ratio)) = beyond_finest {
+                    self.count_beyond_finest(t0 + big_h, h, ratio);
                 }
                 self.finish_step(t0, big_h);
                 Ok(())
@@ -580,6 +593,24 @@ impl Slave {
                 category: category::EVENTS,
                 message: format!(
                     "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled (a motion sampled with its velocities is estimated once they change from update to update and the poses follow them: docs/fmu.md, \"Inputs are samples in time\"). A shorter communication step reduces it, and so does solver.stepSize below the communication step, whose internal steps it then fixes (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
+                ),
+            });
+        }
+    }
+
+    /// Counts a communication step (ending at `t`) kept on the finest rung, internal steps of
+    /// `h`, whose largest estimate was `ratio` (> 1) × its allowance, and warns once: its time
+    /// error is not within `model.accuracy` (docs/formulation.md, "Time error control": the
+    /// ladder).
+    fn count_beyond_finest(&mut self, t: f64, h: f64, ratio: f64) {
+        self.beyond_finest.0 += 1;
+        if !self.beyond_finest.1 {
+            self.beyond_finest.1 = true;
+            self.events.push(LogEvent {
+                category: category::EVENTS,
+                message: format!(
+                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung, internal steps of {h:e} s (solver.stepSize / 2^{MAX_LEVEL}), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
+                    self.parameters.accuracy
                 ),
             });
         }
