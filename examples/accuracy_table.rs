@@ -367,7 +367,14 @@ fn b3_section(quick: bool) {
             hand.push((label, r.wall, e));
         }
     }
-    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
+    // 1e-4 is beyond both the reference (`full` at 2.5 ms is 7.3e-5 of the peak from `full` at
+    // 1.25 ms) and the 40 slabs' model (docs/benchmarks.md): measured, and said, not met.
+    let accuracies: &[f64] = if quick {
+        &[1e-2, 1e-3]
+    } else {
+        &[1e-2, 1e-3, 1e-4]
+    };
+    let controlled = controlled_rows(accuracies, &reference, |accuracy| {
         b3(&[("model.accuracy", accuracy)], end, 1e-2)
     });
     compare_with_hand_chosen(&controlled, &hand);
@@ -377,9 +384,21 @@ fn b3_section(quick: bool) {
 fn rod_section(quick: bool) {
     let end = if quick { 1e-3 } else { 4e-3 };
     let h_ref = 1e-4 / 64.0;
-    let reference = conrod(&[("solver.stepSize", h_ref), ("model.accuracy", 0.0)], end).samples;
+    let mut reference = conrod(&[("solver.stepSize", h_ref), ("model.accuracy", 0.0)], end).samples;
+    // The load's onset: over the first 0.1 ms the fixed 1e-4/64 s is itself 4.8e-4 of the peak
+    // off the fixed 1e-4/256 s, which `1e-3` and `1e-4` take there; from 0.5 ms on the two agree
+    // to 5e-6 of the peak, at 0.8 ms to 3e-7 (the onset's ringing has died out). So the first
+    // millisecond is taken from the finer step.
+    let onset = if quick { end } else { 1e-3 };
+    let h_onset = h_ref / 4.0;
+    let fine = conrod(
+        &[("solver.stepSize", h_onset), ("model.accuracy", 0.0)],
+        onset,
+    )
+    .samples;
+    reference[..fine.len()].copy_from_slice(&fine);
     println!(
-        "\nThe connecting rod: big eye driven at 0.5 m/s, small eye loaded by −2 kN from t = 0, {end} s, communication step 0.1 ms, solver.stepSize 0.1 ms (the body file's); error: the small eye's x displacement against the fixed step {h_ref:e} s, over its peak. Hand-chosen: fixed steps (one frame: a stiff part that hardly turns needs no other term)\n"
+        "\nThe connecting rod: big eye driven at 0.5 m/s, small eye loaded by −2 kN from t = 0, {end} s, communication step 0.1 ms, solver.stepSize 0.1 ms (the body file's); error: the small eye's x displacement against the fixed step {h_ref:e} s ({h_onset:e} s over the first {onset:e} s, the load's onset, where the coarser reference is itself 4.8e-4 of the peak off), over its peak. Hand-chosen: fixed steps (one frame: a stiff part that hardly turns needs no other term)\n"
     );
     println!("| setting | internal steps | redone | wall (ms) | error / peak |");
     println!("|---|---|---|---|---|");
@@ -388,7 +407,12 @@ fn rod_section(quick: bool) {
     let hand = fixed_step_rows(&steps, &reference, |h| {
         conrod(&[("solver.stepSize", h), ("model.accuracy", 0.0)], end)
     });
-    let controlled = controlled_rows(&[1e-2, 1e-3], &reference, |accuracy| {
+    let accuracies: &[f64] = if quick {
+        &[1e-2, 1e-3]
+    } else {
+        &[1e-2, 1e-3, 1e-4]
+    };
+    let controlled = controlled_rows(accuracies, &reference, |accuracy| {
         conrod(&[("model.accuracy", accuracy)], end)
     });
     compare_with_hand_chosen(&controlled, &hand);
