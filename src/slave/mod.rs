@@ -184,7 +184,8 @@ pub struct Slave {
     /// has warned of them.
     unestimated: (u64, u32, bool),
     /// Communication steps accepted on the finest rung though an internal step's estimate
-    /// exceeded its allowance, and whether the body has warned of them.
+    /// exceeded its allowance, and whether the body has warned of them. Like `unestimated`, a
+    /// count of the run as it went (an FMU state restored does not take it back).
     beyond_finest: (u64, bool),
     /// Whether the body has warned that a step was accepted on the iteration's floor rather than
     /// on `model.accuracy` (`slave::stepping::internal_steps`).

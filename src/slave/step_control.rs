@@ -381,6 +381,12 @@ mod tests {
         assert_eq!(level_of_step(2e-3, 2e-3 / 3.0), 1);
         assert_eq!(level_of_step(1.0, 1e-9), MAX_LEVEL);
         assert_eq!(fresh.redo_level(0, 7, 2.31), 8);
+        assert_eq!(fresh.redo_level(0, 4, 2.31), 6);
+        // An unconfirmed rung above rungs that take the same steps: from the step taken.
+        assert_eq!(grown.redo_level(2, 5, 2.31), 6);
+        // `internal_steps` splits a step within 1e-9 of a rung as that rung.
+        assert_eq!(level_of_step(2e-3, 1e-3 * (1.0 + 5e-10)), 1);
+        assert_eq!(level_of_step(2e-3, 1e-3 * (1.0 - 5e-10)), 1);
         assert_eq!(finer_level(3, 2.31), 5);
         let mut back = grown.after_refinement(3);
         assert_eq!(back.probe_after, 2 * PROBE_FIRST);

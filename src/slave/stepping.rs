@@ -99,8 +99,9 @@ impl Slave {
         // (tests/python/test_coupling.py: the work on A grew from 2.3e-4 J to 1.1 J at
         // H = 2e-4 s). Input derivatives give continuous loads instead.
         let mut failed_probe = false;
-        // The rung and the error ratio of the first attempt that was refined.
-        let mut refined_from: Option<(u32, f64)> = None;
+        // The rung, the rung of its internal steps and the error ratio of the first attempt
+        // that was refined.
+        let mut refined_from: Option<(u32, u32, f64)> = None;
         let mut taken = (0, 0.0);
         // The slabs' carry-over is logged once, not per attempt.
         // Whether model.auto's slabs came on at this communication point (in this attempt).
@@ -206,7 +207,7 @@ impl Slave {
                 continue;
             }
             let ratio = self.step_error.unwrap_or(0.0);
-            if let Some((coarser, estimate)) = refined_from {
+            if let Some((first_level, coarser, estimate)) = refined_from {
                 // The ratio falls like h² (4× per rung): one that fell by less than 2 is the
                 // iteration's noise, or a ringing the step does not resolve, whose filtered
                 // estimate is about its amplitude: below half the budget `ε D`, its error (at
@@ -246,18 +247,20 @@ impl Slave {
                     });
                     dynamics.state.copy_from(self.backup.as_ref().unwrap());
                     before.restore_scales(dynamics);
-                    level = coarser;
+                    level = first_level;
                     refined_from = None;
                     continue;
                 }
             }
             if result.is_ok() && ratio > 1.0 && taken_level < MAX_LEVEL {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
-                // control"), a probe on the rung it came from; as far down as the accuracy asks:
-                // a step rejected on the iteration's floor has an estimate above that floor,
-                // error of the time step, and must meet the allowance below it
-                // (docs/formulation.md, "The iteration's tolerance").
-                let finer = if probing {
+                // control"): a probe on the rung it came from (unless that rung takes the same
+                // internal steps); on a rung not yet confirmed, the rung it came from
+                // (`Ladder::redo_level`); elsewhere as far down as the accuracy asks: a step
+                // rejected on the iteration's floor has an estimate above that floor, error of
+                // the time step, and must meet the allowance below it (docs/formulation.md, "The
+                // iteration's tolerance").
+                let finer = if probing && ladder.level > taken_level {
                     ladder.level
                 } else {
                     ladder.redo_level(level, taken_level, ratio.max(self.step_error_unfloored))
@@ -283,7 +286,7 @@ impl Slave {
                 dynamics.state.copy_from(backup);
                 before.restore_scales(dynamics);
                 if !probing && refined_from.is_none() {
-                    refined_from = Some((taken_level, ratio));
+                    refined_from = Some((level, taken_level, ratio));
                 }
                 level = finer;
                 if probing {
@@ -609,7 +612,8 @@ impl Slave {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung, internal steps of {h:e} s (solver.stepSize / 2^{MAX_LEVEL}), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
+                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung (solver.stepSize / 2^{MAX_LEVEL} = {:e} s; internal steps of {h:e} s), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
+                    rung(self.parameters.step_size, MAX_LEVEL),
                     self.parameters.accuracy
                 ),
             });
