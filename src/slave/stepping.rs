@@ -7,16 +7,16 @@ use super::auto_features::{
 use super::interfaces::extrapolate;
 use super::step_control::{
     level_of_step, rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS,
-    NOISE_MARGIN, UNESTIMATED_WARN_AFTER,
+    NOISE_MARGIN,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
-use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
 use internal_steps::observe_deformation;
 
 mod internal_steps;
+mod run_warnings;
 
 /// How often an internal step that did not converge is retried with halved internal steps
 /// (2, 4, ..., 2^MAX_STEP_HALVINGS steps in its place) before the communication step is
@@ -577,71 +577,6 @@ impl Slave {
         self.watch_strain(t0 + big_h);
         if self.results.is_some() {
             self.write_results();
-        }
-    }
-
-    /// Counts a communication step (ending at `t`, internal steps of `h`) that nothing
-    /// estimated, and warns once when [`UNESTIMATED_WARN_AFTER`] came in a row: their time error
-    /// is not controlled (docs/formulation.md, "Time error control").
-    fn count_unestimated(&mut self, t: f64, h: f64) {
-        if self.step_error.is_some() {
-            self.unestimated.1 = 0;
-            return;
-        }
-        self.unestimated.0 += 1;
-        self.unestimated.1 += 1;
-        if self.unestimated.1 == UNESTIMATED_WARN_AFTER && !self.unestimated.2 {
-            self.unestimated.2 = true;
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message: format!(
-                    "warning: model.accuracy: up to t = {t} the last {UNESTIMATED_WARN_AFTER} communication steps were not estimated: each was one internal step ({h:e} s) that starts where an input jumps (a motion interface's pose or velocity, or a force input, set anew), or lies within the first {MOTION_RINGING_STEPS} internal steps after a sampled motion input's jump, whose error the estimate cannot tell from the inputs' sampling. The time error of such steps is not controlled (a motion sampled with its velocities is estimated once they change from update to update and the poses follow them: docs/fmu.md, \"Inputs are samples in time\"). A shorter communication step reduces it, and so does solver.stepSize below the communication step, whose internal steps it then fixes (docs/formulation.md, \"Time error control\"); the run summary counts these steps"
-                ),
-            });
-        }
-    }
-
-    /// Counts a communication step (ending at `t`) kept on the finest rung, internal steps of
-    /// `h`, whose largest estimate was `ratio` (> 1) × its allowance, and warns once: its time
-    /// error is not within `model.accuracy` (docs/formulation.md, "Time error control": the
-    /// ladder).
-    fn count_beyond_finest(&mut self, t: f64, h: f64, ratio: f64) {
-        self.beyond_finest.0 += 1;
-        if !self.beyond_finest.1 {
-            self.beyond_finest.1 = true;
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message: format!(
-                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung (solver.stepSize / 2^{MAX_LEVEL} = {:e} s; internal steps of {h:e} s), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
-                    rung(self.parameters.step_size, MAX_LEVEL),
-                    self.parameters.accuracy
-                ),
-            });
-        }
-    }
-
-    /// The small-strain watch: a message when `‖∇ū‖` crosses the threshold at time `t` (once
-    /// per crossing; again after it fell below half of it).
-    fn watch_strain(&mut self, t: f64) {
-        let model = self.model.as_mut().expect("the model exists after a step");
-        let Some((monitor, above)) = &mut model.strain_monitor else {
-            return;
-        };
-        let g = monitor.largest_gradient(model.forces.force_scratch().local_deformation());
-        if g > DEFAULT_THRESHOLD && !*above {
-            *above = true;
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message: format!(
-                    "warning: at t = {t} the deformation gradient in the co-moving frame reached ‖∇ū‖ ≈ {g:.3} (> {DEFAULT_THRESHOLD}): beyond the small-strain range of the reduced strain the results lose accuracy without other signs; use model.frames > 1 for large bending or model.formulation = full"
-                ),
-            });
-        } else if g < 0.5 * DEFAULT_THRESHOLD && *above {
-            *above = false;
-            self.events.push(LogEvent {
-                category: category::EVENTS,
-                message: format!("at t = {t} ‖∇ū‖ ≈ {g:.3} is back within the small-strain range"),
-            });
         }
     }
 
