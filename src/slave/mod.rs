@@ -469,12 +469,6 @@ impl Slave {
         self.retries
     }
 
-    /// The deformation scale `D` of the error control so far (m; docs/formulation.md, "Time
-    /// error control"), 0 before the first step.
-    pub fn deformation_scale(&self) -> f64 {
-        self.dynamics.as_ref().map_or(0.0, |d| d.deformation_scale)
-    }
-
     /// Communication steps redone with finer internal steps because the estimated error
     /// exceeded `model.accuracy`.
     pub fn rejected_steps(&self) -> u64 {

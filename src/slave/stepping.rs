@@ -106,16 +106,16 @@ impl Slave {
         // The slabs' carry-over is logged once, not per attempt.
         // Whether model.auto's slabs came on at this communication point (in this attempt).
         let (mut carry_over_logged, mut switch_rings, mut slabs_came_on) = (false, false, false);
-        let (result, beyond_finest) = loop {
+        let result = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
                 Ok(step) => step,
-                Err(e) => break (Err(e), None),
+                Err(e) => break Err(e),
             };
             taken = (n, h);
             // The rung of the steps taken: coarser rungs than the communication step are its.
             let taken_level = level.max(level_of_step(self.parameters.step_size, h));
             if let Err(e) = self.prepare_step(h) {
-                break (Err(e), None);
+                break Err(e);
             }
             backed_up = true;
             let dynamics = self.dynamics.as_mut().unwrap();
@@ -295,9 +295,7 @@ impl Slave {
                 }
                 continue;
             }
-            // Kept with its estimate above the allowance: only on the finest rung.
-            let beyond_finest = (result.is_ok() && ratio > 1.0).then_some((h, ratio));
-            break (result, beyond_finest);
+            break result;
         };
         let dynamics = self.dynamics.as_mut().unwrap();
         let result = result.and_then(|()| {
@@ -363,8 +361,9 @@ impl Slave {
                 if controlled {
                     self.count_unestimated(t0 + big_h, taken.1);
                 }
-                if let Some((h, ratio)) = beyond_finest {
-                    self.count_beyond_finest(t0 + big_h, h, ratio);
+                // Kept with its estimate above the allowance: only on the finest rung.
+                if let Some(ratio) = self.step_error.filter(|&r| r > 1.0) {
+                    self.count_beyond_finest(t0 + big_h, taken.1, ratio);
                 }
                 self.finish_step(t0, big_h);
                 Ok(())
