@@ -9,6 +9,7 @@ pub mod lowest_modes;
 pub mod lumped_body;
 pub mod patches;
 pub mod reduction;
+pub mod slab_stiffening;
 pub mod stiffening;
 pub mod strain_monitor;
 

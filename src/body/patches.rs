@@ -23,6 +23,7 @@
 //! Jacobian differs from it by the patches' rotations relative to the body frame.
 
 use super::frame::{add_node, node, set_node, FrameWeights};
+use super::slab_stiffening::SlabStiffening;
 use crate::error::{Error, Result};
 use crate::fem::{self, IsotropicMaterial};
 use crate::linalg::sparse::BlockCsr3;
@@ -39,6 +40,10 @@ pub struct Patch {
     pub frame_weights: FrameWeights,
     /// `K_p` on the patch's local nodes (N/m).
     stiffness: BlockCsr3,
+    /// The patch's elements on its local nodes.
+    mesh: Mesh,
+    /// The geometric stiffness of the patch's own prestress ([`Patches::with_stiffening`]).
+    stiffening: Option<SlabStiffening>,
 }
 
 /// The patches of a body and the length of the largest one (for scratch).
@@ -49,6 +54,10 @@ pub struct Patches {
     /// the iteration, see `solver::generalized_alpha`).
     pub node_patch: Vec<usize>,
     largest: usize,
+    /// The material of the slabs' prestress.
+    material: IsotropicMaterial,
+    /// `ū_p` of [`Patches::update_stiffening`] (m; the largest patch's length).
+    update_scratch: Vec<f64>,
 }
 
 /// Scratch of [`Patches::internal_force`]: `ū_p` and `g_p` of the largest patch, and the
@@ -191,6 +200,8 @@ impl Patches {
                 elements,
                 frame_weights: FrameWeights::new(global, weights, &reference),
                 stiffness,
+                mesh: sub,
+                stiffening: None,
             });
         }
         let largest = patches
@@ -210,7 +221,43 @@ impl Patches {
             patches,
             node_patch,
             largest,
+            material: *material,
+            update_scratch: vec![0.0; 3 * largest],
         })
+    }
+
+    /// The patches with their own geometric stiffening, `R_p (G_p ⊗ I3) ū_p` in each patch's
+    /// force (zero until [`Self::update_stiffening`]; docs/formulation.md, "Geometric
+    /// stiffening within the slabs"). Set-up only (allocates).
+    pub fn with_stiffening(mut self) -> Patches {
+        for patch in &mut self.patches {
+            patch.stiffening = Some(SlabStiffening::new(&patch.mesh, &self.material));
+        }
+        self
+    }
+
+    /// Whether the patches have their own stiffening ([`Self::with_stiffening`]).
+    pub fn has_stiffening(&self) -> bool {
+        self.patches.iter().all(|p| p.stiffening.is_some())
+    }
+
+    /// Refreshes each slab's `G_p` from its local deformation `ū_p` at positions `x` (flat, m):
+    /// the prestress of the state at a communication step's start. No allocation.
+    pub fn update_stiffening(&mut self, x: &[f64]) {
+        for patch in &mut self.patches {
+            let Some(stiffening) = patch.stiffening.as_mut() else {
+                continue;
+            };
+            let fw = &patch.frame_weights;
+            let ubar = &mut self.update_scratch[..3 * fw.nodes.len()];
+            let frame = fw.best_fit(x);
+            let rt = frame.rotation.transpose();
+            for (k, &n) in fw.nodes.iter().enumerate() {
+                let u = rt * (node(x, n) - frame.origin) - fw.reference_offsets[k];
+                set_node(ubar, k, &u);
+            }
+            stiffening.update(ubar);
+        }
     }
 
     /// The patches of a body with `total` nodes, the mesh's and after them a lumped body's mass
@@ -300,6 +347,9 @@ impl Patches {
             }
             patch.stiffness.mul_vec(ubar, g);
             energy += 0.5 * crate::linalg::dot(ubar, g);
+            if let Some(stiffening) = &patch.stiffening {
+                energy += stiffening.add_force(ubar, g);
+            }
             let z = if nonlinear_forces {
                 let mut mbar = Vector3::zeros();
                 for k in 0..fw.nodes.len() {

@@ -245,6 +245,73 @@ pub fn geometric_stiffness_into(mesh: &Mesh, stress: &[[f64; 6]], out: &mut Symm
     }
 }
 
+/// The geometric stiffness of element `e` of `mesh` per unit of each prestress component, for a
+/// prestress constant over the element, and the element's volume-mean shape-function gradients:
+///
+/// * `G_k[a][b] = ∫_e ∇N_a · E_k ∇N_b dV` (m) for the Voigt unit stresses `E_k` (order of the
+///   module doc; the shear ones have 1 in both off-diagonal places), upper triangle `a ≤ b` row
+///   by row (`n(n+1)/2` entries for `n` nodes), so that a constant prestress `S̄` gives
+///   `K_G,e = (Σ_k S̄_k G_k) ⊗ I3`, [`geometric_stiffness`] with `S̄` at every Gauss point;
+/// * `ḡ_a = (1/V_e) ∫_e ∇N_a dV` (1/m), so that the element's mean displacement gradient is
+///   `Σ_a u_a ⊗ ḡ_a`.
+///
+/// Set-up only (allocates). Panics if the element is inverted.
+pub fn unit_stress_geometric_stiffness(mesh: &Mesh, e: usize) -> ([Vec<f64>; 6], Vec<[f64; 3]>) {
+    let reference = ReferenceGradients::new(mesh.kind());
+    let n = mesh.kind().node_count();
+    let mut coords = [[0.0; 3]; MAX_NODES];
+    let mut gradients = [[0.0; 3]; MAX_NODES];
+    element_coordinates(mesh, e, &mut coords);
+    let mut unit: [Vec<f64>; 6] = std::array::from_fn(|_| vec![0.0; n * (n + 1) / 2]);
+    let mut mean = vec![[0.0; 3]; n];
+    let mut volume = 0.0;
+    // The index pairs (i, j) of `E_k`'s entries, each entry 1.
+    const PAIRS: [&[(usize, usize)]; 6] = [
+        &[(0, 0)],
+        &[(1, 1)],
+        &[(2, 2)],
+        &[(1, 2), (2, 1)],
+        &[(0, 2), (2, 0)],
+        &[(0, 1), (1, 0)],
+    ];
+    for (q, &weight) in reference.weights.iter().enumerate() {
+        let det = physical_gradients(
+            &coords[..n],
+            &reference.derivatives[q][..n],
+            &mut gradients[..n],
+        );
+        assert!(
+            det > 0.0,
+            "unit_stress_geometric_stiffness: element {e} inverted"
+        );
+        let w = weight * det;
+        volume += w;
+        for (m, g) in mean.iter_mut().zip(&gradients[..n]) {
+            for i in 0..3 {
+                m[i] += w * g[i];
+            }
+        }
+        for (k, pairs) in PAIRS.iter().enumerate() {
+            let mut entry = 0;
+            for a in 0..n {
+                for b in a..n {
+                    unit[k][entry] += w * pairs
+                        .iter()
+                        .map(|&(i, j)| gradients[a][i] * gradients[b][j])
+                        .sum::<f64>();
+                    entry += 1;
+                }
+            }
+        }
+    }
+    for m in &mut mean {
+        for v in m.iter_mut() {
+            *v /= volume;
+        }
+    }
+    (unit, mean)
+}
+
 /// `out = Σ_k c_k A_k` entry by entry, for matrices sharing one pattern (that of `out`): e.g.
 /// `K_G = Σ_k c_k K_G,k` from precomputed unit load cases (`K_G` is linear in the stress), or
 /// `K + K_G`. Allocation-free, one pass over the values per term (`nnz` multiply-adds each).
@@ -566,5 +633,68 @@ mod tests {
         let smaller = k_g.submatrix(&[0, 1, 2]);
         let mut out = k_g.clone();
         weighted_sum_into(&mut out, &[(1.0, &smaller)]);
+    }
+
+    #[test]
+    fn unit_stress_stiffness_sums_to_the_assembly_of_a_constant_stress() {
+        // With the same stress at every Gauss point of every element, Σ_k S_k G_e,k assembled
+        // over the elements is `geometric_stiffness`; the mean gradients reproduce the gradient
+        // of a linear field (Σ_a X_a ⊗ ḡ_a = I).
+        for kind in [
+            ElementKind::Hex8,
+            ElementKind::Hex20,
+            ElementKind::Tet4,
+            ElementKind::Tet10,
+        ] {
+            let mesh = distorted_block(kind);
+            let stress = [3.0e5, -1.2e5, 0.7e5, 2.1e4, -4.4e4, 1.3e4];
+            let k_g = geometric_stiffness(&mesh, &vec![stress; gauss_point_count(&mesh)]);
+            let mut assembled = stiffness_pattern(&mesh);
+            for e in 0..mesh.element_count() {
+                let (unit, mean) = unit_stress_geometric_stiffness(&mesh, e);
+                let nodes = mesh.element(e);
+                let mut entry = 0;
+                for a in 0..nodes.len() {
+                    for b in a..nodes.len() {
+                        let value: f64 = (0..6).map(|k| stress[k] * unit[k][entry]).sum();
+                        entry += 1;
+                        for d in 0..3 {
+                            let (row, column) = (3 * nodes[a] + d, 3 * nodes[b] + d);
+                            let places: &[(usize, usize)] = if a == b {
+                                &[(row, column)]
+                            } else {
+                                &[(row, column), (column, row)]
+                            };
+                            for &(r, c) in places {
+                                let range = assembled.row_ptr[r]..assembled.row_ptr[r + 1];
+                                let k = assembled.col_idx[range.clone()].binary_search(&c).unwrap();
+                                assembled.values[range.start + k] += value;
+                            }
+                        }
+                    }
+                }
+                let mut identity = [[0.0; 3]; 3];
+                for (&n, g) in nodes.iter().zip(&mean) {
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            identity[r][c] += mesh.nodes()[n][r] * g[c];
+                        }
+                    }
+                }
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let expected = if r == c { 1.0 } else { 0.0 };
+                        assert!(
+                            (identity[r][c] - expected).abs() < 1e-12,
+                            "{kind:?}: {identity:?}"
+                        );
+                    }
+                }
+            }
+            let scale = max_abs(&k_g.values);
+            for (x, y) in assembled.values.iter().zip(&k_g.values) {
+                assert!((x - y).abs() <= 1e-12 * scale, "{kind:?}: {x} vs {y}");
+            }
+        }
     }
 }

@@ -84,9 +84,9 @@ pub(super) fn choose_features(
             e.nonlinear_forces,
             "the nonlinear force f_nl",
         );
-        // The stiffening acts on the one frame's deformation `ū`: with the slabs, which turn
-        // apart from that frame, it is off (on B3 the slabs with stiffening ended 1.3e-2 of
-        // the peak from `full`, without 2.1e-3; docs/fmu.md, "model.auto").
+        // The one frame's stiffening acts on its deformation `ū`: with the slabs, which turn
+        // apart from that frame, it is off (on B3 the slabs with it ended 1.3e-2 of the peak
+        // from `full`, without 2.1e-3; docs/fmu.md, "model.auto"); the slabs carry their own.
         decide(
             &mut f.stiffening,
             quiet_stiffening,
@@ -427,11 +427,11 @@ fn choose_slabs(
         events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "model.auto: at t = {} the body bends far against its co-moving frame (‖∇ū‖ ≈ {g:.3}; the single frame's error ≈ {BENDING_ERROR} ‖∇ū‖² = {estimate:.2e} > {SWITCH_AT} × model.accuracy = {accuracy:e}): {} co-moving frames (slabs, one per element layer) from now on{}",
+                "model.auto: at t = {} the body bends far against its co-moving frame (‖∇ū‖ ≈ {g:.3}; the single frame's error ≈ {BENDING_ERROR} ‖∇ū‖² = {estimate:.2e} > {SWITCH_AT} × model.accuracy = {accuracy:e}): {} co-moving frames (slabs, one per element layer) from now on, each with the stiffening of its own prestress{}",
                 dynamics.state.time,
                 model.parked_slab_count(),
                 if dynamics.features.stiffening {
-                    ", without the geometric stiffening (it acts on the one frame's deformation, which the slabs replace)"
+                    " in place of the one frame's geometric stiffening (which acts on the one frame's deformation, which the slabs replace)"
                 } else {
                     ""
                 }

@@ -524,6 +524,17 @@ impl Slave {
                 k_g,
             );
         }
+        // The slabs' own prestress, from the state at the step's start as the one frame's `K_G`
+        // (docs/formulation.md, "Geometric stiffening within the slabs").
+        let reduced = model.body.reduction.is_some();
+        if let Some(patches) = model
+            .body
+            .patches
+            .as_mut()
+            .filter(|p| p.has_stiffening() && !reduced)
+        {
+            patches.update_stiffening(&dynamics.state.position);
+        }
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
         Ok(())
