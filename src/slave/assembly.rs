@@ -42,6 +42,11 @@ pub struct Features {
     /// The linear body (docs/formulation.md, "The linear body"): the frame held at the
     /// placement, [`Model::parked_linear`].
     pub linear: bool,
+    /// The slabs' own stiffening (docs/formulation.md, "Geometric stiffening within the
+    /// slabs"): `model.auto`'s slabs take it once it changes their stiffness by more than
+    /// [`SWITCH_AT`](super::auto_features::SWITCH_AT) × `model.accuracy`; forced slabs with
+    /// `model.stiffening = stress` have it throughout.
+    pub slab_stiffening: bool,
 }
 
 /// The assembled model for one set of parameters.
@@ -102,6 +107,9 @@ impl Model {
         let slabs = self.body.patches.is_some();
         if self.allowed.frames && features.frames != slabs {
             std::mem::swap(&mut self.body.patches, &mut self.parked_patches);
+        }
+        if let Some(patches) = self.body.patches.as_mut() {
+            patches.stiffening_active = features.slab_stiffening && patches.has_stiffening();
         }
         let active = self.forces.geometric_stiffness.is_some();
         if features.stiffening != active {
@@ -522,10 +530,11 @@ impl Slave {
             // The mesh's nodes only: a lumped body's mass points would tilt the slabs' axis.
             let mesh_lumped = &lumped[..self.mesh.node_count()];
             let layers = Patches::element_layers(&self.mesh, mesh_lumped);
-            // With their own stiffening, whatever `model.stiffening` allows: on B3 it takes the
-            // slabs' model error from 2.5e-4 to 4.1e-5 of the peak (40 slabs at a fixed 2.5 ms
-            // against `full` at 2.5 ms) for about 9 % of the run time (docs/formulation.md,
-            // "Geometric stiffening within the slabs").
+            // With their own stiffening, whatever `model.stiffening` allows, switched on where
+            // the accuracy asks for it (`auto_features::choose_slab_stiffening`): on B3 it takes
+            // the slabs' model error from 2.5e-4 to 4.1e-5 of the peak (40 slabs at a fixed
+            // 2.5 ms against `full` at 2.5 ms; docs/formulation.md, "Geometric stiffening within
+            // the slabs").
             body.patches = Some(
                 Patches::along_principal_axis(&self.mesh, &p.material, mesh_lumped, layers)?
                     .covering(body.node_count())
@@ -558,6 +567,8 @@ impl Slave {
             frames: auto_slabs,
             frames_refused: false,
             linear: self.linear_allowed()?,
+            slab_stiffening: auto_slabs
+                || body.patches.as_ref().is_some_and(|p| p.has_stiffening()),
         };
         let indicators = self.feature_indicators(&body, &free, stiffening.as_ref(), allowed);
         // f_nl is switched only on a body without supports; with supports and one frame

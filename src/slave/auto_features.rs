@@ -86,7 +86,8 @@ pub(super) fn choose_features(
         );
         // The one frame's stiffening acts on its deformation `ū`: with the slabs, which turn
         // apart from that frame, it is off (on B3 the slabs with it ended 1.3e-2 of the peak
-        // from `full`, without 2.1e-3; docs/fmu.md, "model.auto"); the slabs carry their own.
+        // from `full`, without 2.1e-3; docs/fmu.md, "model.auto"); the slabs take their own
+        // ([`choose_slab_stiffening`]).
         decide(
             &mut f.stiffening,
             quiet_stiffening,
@@ -390,6 +391,42 @@ pub(super) fn carry_over_to_slabs(
     Some(carried)
 }
 
+/// The slabs' own stiffening (docs/formulation.md, "Geometric stiffening within the slabs"):
+/// refreshes each slab's `G_p` from the state at the communication step's start, and switches
+/// it on for `model.auto`'s slabs, once and for good, at the first communication point where it
+/// changes their stiffness (the energy ratio of [`Patches::update_stiffening`]) by more than
+/// [`SWITCH_AT`] × `model.accuracy`; logged. No allocation unless the decision changes.
+///
+/// [`Patches::update_stiffening`]: crate::body::patches::Patches::update_stiffening
+pub(super) fn choose_slab_stiffening(
+    model: &mut Model,
+    dynamics: &mut Dynamics,
+    accuracy: f64,
+    events: &mut Vec<LogEvent>,
+) {
+    if model.body.reduction.is_some() {
+        return;
+    }
+    let f = dynamics.features;
+    let decides = model.allowed.frames && f.frames && !f.slab_stiffening;
+    let Some(patches) = model.body.patches.as_mut().filter(|p| p.has_stiffening()) else {
+        return;
+    };
+    let ratio = patches.update_stiffening(&dynamics.state.position, decides);
+    if let Some(ratio) = ratio.filter(|&r| r > SWITCH_AT * accuracy) {
+        dynamics.features.slab_stiffening = true;
+        model.apply_features(dynamics.features);
+        events.push(LogEvent {
+            category: category::EVENTS,
+            message: format!(
+                "model.auto: at t = {} the slabs' own geometric stiffening switched on: their prestress changes their stiffness by {ratio:.3e} > {SWITCH_AT} × model.accuracy = {:e} (docs/formulation.md, \"Geometric stiffening within the slabs\")",
+                dynamics.state.time,
+                SWITCH_AT * accuracy
+            ),
+        });
+    }
+}
+
 /// `model.auto`'s slabs (one co-moving frame per element layer along the body's long axis,
 /// `Patches::element_layers`): switched on, once and for good, at the first communication
 /// point where the single frame's error estimate `BENDING_ERROR × ‖∇ū‖²` (the strain watch's
@@ -427,11 +464,11 @@ fn choose_slabs(
         events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "model.auto: at t = {} the body bends far against its co-moving frame (‖∇ū‖ ≈ {g:.3}; the single frame's error ≈ {BENDING_ERROR} ‖∇ū‖² = {estimate:.2e} > {SWITCH_AT} × model.accuracy = {accuracy:e}): {} co-moving frames (slabs, one per element layer) from now on, each with the stiffening of its own prestress{}",
+                "model.auto: at t = {} the body bends far against its co-moving frame (‖∇ū‖ ≈ {g:.3}; the single frame's error ≈ {BENDING_ERROR} ‖∇ū‖² = {estimate:.2e} > {SWITCH_AT} × model.accuracy = {accuracy:e}): {} co-moving frames (slabs, one per element layer) from now on{}",
                 dynamics.state.time,
                 model.parked_slab_count(),
                 if dynamics.features.stiffening {
-                    " in place of the one frame's geometric stiffening (which acts on the one frame's deformation, which the slabs replace)"
+                    ", without the one frame's geometric stiffening (it acts on the one frame's deformation, which the slabs replace; they take their own where model.accuracy asks for it)"
                 } else {
                     ""
                 }

@@ -48,6 +48,8 @@ impl Slave {
                 frames: false,
                 frames_refused: false,
                 linear: false,
+                // Forced slabs' own stiffening from the start; model.auto's comes on later.
+                slab_stiffening: model.allowed.slab_stiffening && !model.allowed.frames,
             },
             // A reduced body's stiffening from the driving motion starts off when model.auto
             // switches it: the first step's communication point decides.
@@ -55,6 +57,7 @@ impl Slave {
                 frames: false,
                 linear: false,
                 stiffening: model.allowed.stiffening && model.driven_stiffening.is_none(),
+                slab_stiffening: model.allowed.slab_stiffening && !model.allowed.frames,
                 ..model.allowed
             },
         };

@@ -233,7 +233,8 @@ impl SlaveState {
                     | u8::from(d.features.stiffening) << 1
                     | u8::from(d.features.frames) << 2
                     | u8::from(d.features.frames_refused) << 3
-                    | u8::from(d.features.linear) << 4);
+                    | u8::from(d.features.linear) << 4
+                    | u8::from(d.features.slab_stiffening) << 5);
                 w.f64s(&d.quiet_since);
                 w.u32(d.ladder.level);
                 w.u32(d.ladder.calm_steps);
@@ -423,16 +424,17 @@ impl Slave {
                 let mut gravity = [0.0; 3];
                 r.f64s(&mut gravity, "the gravity of the state")?;
                 let features = match r.u8("the terms in force")? {
-                    b @ 0..=31 => super::Features {
+                    b @ 0..=63 => super::Features {
                         nonlinear_forces: b & 1 != 0,
                         stiffening: b & 2 != 0,
                         frames: b & 4 != 0,
                         frames_refused: b & 8 != 0,
                         linear: b & 16 != 0,
+                        slab_stiffening: b & 32 != 0,
                     },
                     b => {
                         return Err(Error::new(format!(
-                            "the serialized FMU state holds {b} for the terms in force: not 0 to 31"
+                            "the serialized FMU state holds {b} for the terms in force: not 0 to 63"
                         )))
                     }
                 };

@@ -1,8 +1,8 @@
 //! `fmi2DoStep`: a communication step as internal steps, with halving retries and rollback.
 
 use super::auto_features::{
-    carry_over_to_slabs, choose_driven_stiffening, choose_features, linear_reach_exceeded,
-    LINEAR_AT, NOT_QUIET,
+    carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
+    linear_reach_exceeded, LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -524,17 +524,7 @@ impl Slave {
                 k_g,
             );
         }
-        // The slabs' own prestress, from the state at the step's start as the one frame's `K_G`
-        // (docs/formulation.md, "Geometric stiffening within the slabs").
-        let reduced = model.body.reduction.is_some();
-        if let Some(patches) = model
-            .body
-            .patches
-            .as_mut()
-            .filter(|p| p.has_stiffening() && !reduced)
-        {
-            patches.update_stiffening(&dynamics.state.position);
-        }
+        choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
         Ok(())
