@@ -552,3 +552,43 @@ fn stepping_several_times_per_input_update_follows_the_motion_between_updates() 
     );
     assert!(four < 0.5 * one, "four steps {four:e}, one step {one:e}");
 }
+
+/// The slabs' own stiffening, switched on by model.auto at 1e-3 during the spin-up (the slabs
+/// come on at about 1.7 s, their own stiffening later), is part of the FMU state (a feature bit; `G_p` follows from the positions):
+/// the saving instance and a fresh one, given a state saved after that, repeat the later steps
+/// bit for bit.
+#[test]
+fn the_slabs_own_stiffening_is_part_of_the_state() {
+    let settings = [("model.accuracy", 1e-3)];
+    let mut s = initialized(b3_body(), &settings);
+    let drive = common::b3::HubDrive::new(&s);
+    let mut log = Vec::new();
+    for k in 0..750 {
+        drive.step(&mut s, k as f64 * H, H).unwrap();
+        log.extend(s.drain_events().map(|e| e.message));
+    }
+    assert!(
+        log.iter()
+            .any(|m| m.contains("the slabs' own geometric stiffening switched on")),
+        "{:?}",
+        log.iter()
+            .filter(|m| m.starts_with("model.auto"))
+            .collect::<Vec<_>>()
+    );
+    let mut saved = Vec::new();
+    s.get_state().write_bytes(&mut saved);
+    let later = |s: &mut flexbody::slave::Slave| -> Vec<f64> {
+        (750..770)
+            .map(|k| drive.step(s, k as f64 * H, H).unwrap())
+            .collect()
+    };
+    let expected = later(&mut s);
+    // Restored into the instance that went on and into a fresh one, whose slabs are parked.
+    let state = s.state_from_bytes(&saved).unwrap();
+    s.set_state(&state).unwrap();
+    assert_eq!(later(&mut s), expected);
+    let mut fresh = initialized(b3_body(), &settings);
+    let state = fresh.state_from_bytes(&saved).unwrap();
+    fresh.set_state(&state).unwrap();
+    assert_eq!(later(&mut fresh), expected);
+}

@@ -247,7 +247,7 @@ impl Patches {
     /// Refreshes each slab's `G_p` from its local deformation `ū_p` at positions `x` (flat, m):
     /// the prestress of the state at a communication step's start. With `measure`, returns how
     /// much the stiffening changes the slabs' stiffness, the energy ratio
-    /// `Σ_p ū_pᵀ (G_p ⊗ I3) ū_p / Σ_p ū_pᵀ K_p ū_p` (0 without deformation; on B3 it bounds the
+    /// `Σ_p |ū_pᵀ (G_p ⊗ I3) ū_p| / Σ_p ū_pᵀ K_p ū_p` (0 without deformation; on B3 it bounds the
     /// slabs' model error without it within 3×). No allocation.
     pub fn update_stiffening(&mut self, x: &[f64], measure: bool) -> Option<f64> {
         let (mut elastic, mut stiffening_energy) = (0.0, 0.0);
@@ -270,12 +270,13 @@ impl Patches {
                 patch.stiffness.mul_vec(ubar, force);
                 elastic += 0.5 * crate::linalg::dot(ubar, force);
                 force.fill(0.0);
-                stiffening_energy += stiffening.add_force(ubar, force);
+                // Per slab: slabs in tension and in compression do not cancel.
+                stiffening_energy += stiffening.add_force(ubar, force).abs();
             }
         }
         measure.then(|| {
             if elastic > 0.0 {
-                (stiffening_energy / elastic).abs()
+                stiffening_energy / elastic
             } else {
                 0.0
             }
@@ -369,8 +370,11 @@ impl Patches {
             }
             patch.stiffness.mul_vec(ubar, g);
             energy += 0.5 * crate::linalg::dot(ubar, g);
+            // The stiffening's force is a frozen-prestress term, as the one frame's `K_G ū`: it
+            // adds nothing to the strain energy (the output `body.strainEnergy`, the error
+            // control's scale of the modes above the lowest).
             if let Some(stiffening) = patch.stiffening.as_ref().filter(|_| self.stiffening_active) {
-                energy += stiffening.add_force(ubar, g);
+                stiffening.add_force(ubar, g);
             }
             let z = if nonlinear_forces {
                 let mut mbar = Vector3::zeros();

@@ -9,10 +9,11 @@
 //! stress component and `ḡ_e,a` its volume-mean shape-function gradients
 //! ([`fem::geometric::unit_stress_geometric_stiffness`]). `G_p` is refreshed once per
 //! communication step from the state at its start and held during it (as the one frame's
-//! `K_G`); it adds `½ ū_pᵀ (G_p ⊗ I3) ū_p` to the slab's strain energy. It is the second-order
-//! term `½ ∇ūᵀ∇ū` of the Green strain that the slabs' linear strain leaves out, with the
-//! prestress of the slab's linear strain: B3's spin-up stiffens its slabs' bending by the axial
-//! stress of the spin.
+//! `K_G`). It is the work of the slab's prestress on the second-order part `½ ∇ūᵀ∇ū` of its
+//! Green strain, which the slabs' linear strain leaves out, with the prestress frozen (the stress
+//! of that nonlinear strain, the other term of the same order, is not included, and nothing is
+//! added to the strain energy): B3's spin-up stiffens its slabs' bending by the axial stress of
+//! the spin.
 
 use crate::fem::{self, IsotropicMaterial};
 use crate::mesh::Mesh;

@@ -120,6 +120,18 @@ impl Model {
         }
     }
 
+    /// Refreshes the slabs' own stiffening `G_p` from `positions` (docs/formulation.md,
+    /// "Geometric stiffening within the slabs") where the state is put in place without a step
+    /// that would refresh it: a restored FMU state, the initial state. No allocation.
+    pub(super) fn refresh_slab_stiffening(&mut self, positions: &[f64]) {
+        if self.body.reduction.is_some() {
+            return;
+        }
+        if let Some(patches) = self.body.patches.as_mut().filter(|p| p.has_stiffening()) {
+            patches.update_stiffening(positions, false);
+        }
+    }
+
     /// Parks the linear body's placement, the best-fit frame of `positions` (the body placed
     /// rigidly), if the body may be linear; [`Self::apply_features`] puts it in force.
     pub(super) fn place_linear_body(&mut self, positions: &[f64]) {

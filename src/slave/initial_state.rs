@@ -108,6 +108,7 @@ impl Slave {
         let model = self.model.as_mut().unwrap();
         model.place_linear_body(&state.position);
         model.apply_features(features);
+        model.refresh_slab_stiffening(&state.position);
         let body = &model.body;
         let gravity = Vector3::from(self.parameters.gravity);
         let interfaces = &self.interfaces;

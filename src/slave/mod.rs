@@ -605,6 +605,7 @@ impl Slave {
         }
         if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
             model.apply_features(d.features);
+            model.refresh_slab_stiffening(&d.state.position);
         }
         self.outputs.valid = false;
         Ok(())

@@ -136,6 +136,8 @@ impl Slave {
                 )
                 .is_none();
                 carry_over_logged = true;
+                // The slabs' own prestress is that of the state carried over to them.
+                choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -163,6 +165,7 @@ impl Slave {
                 dynamics.state.copy_from(self.backup.as_ref().unwrap());
                 dynamics.features.frames = false;
                 dynamics.features.frames_refused = true;
+                dynamics.features.slab_stiffening = false;
                 let model = self.model.as_mut().unwrap();
                 model.apply_features(dynamics.features);
                 self.events.push(LogEvent {
@@ -499,6 +502,9 @@ impl Slave {
             driven.as_ref(),
             &mut self.events,
         );
+        // Before the slabs may come on: where they do, their state is the one carried over to
+        // them, and `do_step` refreshes (and decides) after the carry-over.
+        choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
         choose_features(
             model,
             dynamics,
@@ -524,7 +530,6 @@ impl Slave {
                 k_g,
             );
         }
-        choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
         let backup = self.backup.get_or_insert_with(|| dynamics.state.clone());
         backup.copy_from(&dynamics.state);
         Ok(())
