@@ -76,15 +76,7 @@ impl SlabStiffening {
                     }
                 }
             }
-            let trace = grad[0][0] + grad[1][1] + grad[2][2];
-            let stress = [
-                lambda * trace + 2.0 * mu * grad[0][0],
-                lambda * trace + 2.0 * mu * grad[1][1],
-                lambda * trace + 2.0 * mu * grad[2][2],
-                mu * (grad[1][2] + grad[2][1]),
-                mu * (grad[0][2] + grad[2][0]),
-                mu * (grad[0][1] + grad[1][0]),
-            ];
+            let stress = fem::geometric::linear_stress(&grad, lambda, mu);
             element.values.fill(0.0);
             for (s, unit) in stress.iter().zip(&element.unit) {
                 for (v, u) in element.values.iter_mut().zip(unit) {

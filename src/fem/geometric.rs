@@ -140,17 +140,23 @@ pub fn stress_at_gauss_points_into(
                     }
                 }
             }
-            let trace = grad[0][0] + grad[1][1] + grad[2][2];
-            stress[e * p + q] = [
-                lambda * trace + 2.0 * mu * grad[0][0],
-                lambda * trace + 2.0 * mu * grad[1][1],
-                lambda * trace + 2.0 * mu * grad[2][2],
-                mu * (grad[1][2] + grad[2][1]),
-                mu * (grad[0][2] + grad[2][0]),
-                mu * (grad[0][1] + grad[1][0]),
-            ];
+            stress[e * p + q] = linear_stress(&grad, lambda, mu);
         }
     }
+}
+
+/// The isotropic linear stress `σ = λ tr(ε) I + 2μ ε`, `ε = sym ∇u` (Pa, Voigt in the order of
+/// the module doc) of the displacement gradient `grad[r][c] = ∂u_r/∂x_c` and Lamé's `λ`, `μ`.
+pub fn linear_stress(grad: &[[f64; 3]; 3], lambda: f64, mu: f64) -> [f64; 6] {
+    let trace = grad[0][0] + grad[1][1] + grad[2][2];
+    [
+        lambda * trace + 2.0 * mu * grad[0][0],
+        lambda * trace + 2.0 * mu * grad[1][1],
+        lambda * trace + 2.0 * mu * grad[2][2],
+        mu * (grad[1][2] + grad[2][1]),
+        mu * (grad[0][2] + grad[2][0]),
+        mu * (grad[0][1] + grad[1][0]),
+    ]
 }
 
 /// The geometric stiffness `K_G(S0)` (N/m, `3N × 3N`) of the Gauss-point prestress `stress`
