@@ -320,7 +320,10 @@ pub fn unit_stress_geometric_stiffness(mesh: &Mesh, e: usize) -> ([Vec<f64>; 6],
 
 /// `out = Σ_k c_k A_k` entry by entry, for matrices sharing one pattern (that of `out`): e.g.
 /// `K_G = Σ_k c_k K_G,k` from precomputed unit load cases (`K_G` is linear in the stress), or
-/// `K + K_G`. Allocation-free, one pass over the values per term (`nnz` multiply-adds each).
+/// `K + K_G`. Allocation-free, `nnz` multiply-adds per term, the terms taken four at a time in
+/// one pass over the values (a reduced body's dense `K_G` is refreshed from four terms in one
+/// pass instead of four); the sum is formed in the terms' order, so the result is that of
+/// adding them one by one.
 ///
 /// Panics if a term's dimension or entry count differs from `out`'s; that the column indices are
 /// identical too is checked in debug builds only (comparing them costs as much as the sum).
@@ -336,16 +339,44 @@ pub fn weighted_sum_into(out: &mut SymmetricCsr, terms: &[(f64, &SymmetricCsr)])
             "weighted_sum_into: a term's pattern differs from the output's"
         );
     }
-    match terms.split_first() {
-        None => out.values.fill(0.0),
-        Some(((c0, first), rest)) => {
-            for (o, &v) in out.values.iter_mut().zip(&first.values) {
-                *o = c0 * v;
+    if terms.is_empty() {
+        out.values.fill(0.0);
+    }
+    for (group, chunk) in terms.chunks(4).enumerate() {
+        add_group(&mut out.values, chunk, group == 0);
+    }
+}
+
+/// `out (=|+=) Σ c_k a_k` over up to four terms in one pass, added in order; `first`: `out` is
+/// overwritten.
+fn add_group(out: &mut [f64], terms: &[(f64, &SymmetricCsr)], first: bool) {
+    let value = |k: usize| (terms[k].0, &terms[k].1.values[..]);
+    match terms.len() {
+        1 => {
+            let (c0, a0) = value(0);
+            for (o, &x0) in out.iter_mut().zip(a0) {
+                *o = if first { c0 * x0 } else { *o + c0 * x0 };
             }
-            for (c, term) in rest {
-                for (o, &v) in out.values.iter_mut().zip(&term.values) {
-                    *o += c * v;
-                }
+        }
+        2 => {
+            let ((c0, a0), (c1, a1)) = (value(0), value(1));
+            for ((o, &x0), &x1) in out.iter_mut().zip(a0).zip(a1) {
+                let s = if first { c0 * x0 } else { *o + c0 * x0 };
+                *o = s + c1 * x1;
+            }
+        }
+        3 => {
+            let ((c0, a0), (c1, a1), (c2, a2)) = (value(0), value(1), value(2));
+            for (((o, &x0), &x1), &x2) in out.iter_mut().zip(a0).zip(a1).zip(a2) {
+                let s = if first { c0 * x0 } else { *o + c0 * x0 };
+                *o = s + c1 * x1 + c2 * x2;
+            }
+        }
+        _ => {
+            let ((c0, a0), (c1, a1), (c2, a2), (c3, a3)) = (value(0), value(1), value(2), value(3));
+            for ((((o, &x0), &x1), &x2), &x3) in out.iter_mut().zip(a0).zip(a1).zip(a2).zip(a3) {
+                let s = if first { c0 * x0 } else { *o + c0 * x0 };
+                *o = s + c1 * x1 + c2 * x2 + c3 * x3;
             }
         }
     }

@@ -278,6 +278,35 @@ fn in_place_and_weighted_sum_agree_with_the_allocating_assembly() {
 }
 
 #[test]
+fn weighted_sum_of_many_terms_is_the_sum_term_by_term() {
+    // Six terms (one group of four, one of two): the same values, bit for bit, as adding the
+    // terms one at a time in their order.
+    let mesh = beam(1.0, 1.0, 1.0, [2, 1, 1], ElementKind::Hex8).unwrap();
+    let count = gauss_point_count(&mesh);
+    let terms: Vec<(f64, SymmetricCsr)> = (0..6)
+        .map(|k| {
+            let stress: Vec<[f64; 6]> = (0..count)
+                .map(|g| std::array::from_fn(|c| ((k * 7 + g * 3 + c) % 11) as f64 - 5.0))
+                .collect();
+            (0.3 * k as f64 - 0.7, geometric_stiffness(&mesh, &stress))
+        })
+        .collect();
+    let refs: Vec<(f64, &SymmetricCsr)> = terms.iter().map(|(c, t)| (*c, t)).collect();
+    for n in 1..=refs.len() {
+        let mut partial = terms[0].1.clone();
+        weighted_sum_into(&mut partial, &refs[..n]);
+        let mut one_by_one = terms[0].1.clone();
+        weighted_sum_into(&mut one_by_one, &refs[..1]);
+        for term in &refs[1..n] {
+            for (v, &x) in one_by_one.values.iter_mut().zip(&term.1.values) {
+                *v += term.0 * x;
+            }
+        }
+        assert_eq!(partial, one_by_one, "{n} terms");
+    }
+}
+
+#[test]
 #[should_panic(expected = "pattern differs")]
 fn weighted_sum_rejects_a_different_pattern() {
     let mesh = beam(1.0, 1.0, 1.0, [1, 1, 1], ElementKind::Hex8).unwrap();
