@@ -350,33 +350,57 @@ pub fn weighted_sum_into(out: &mut SymmetricCsr, terms: &[(f64, &SymmetricCsr)])
 /// `out (=|+=) Σ c_k a_k` over up to four terms in one pass, added in order; `first`: `out` is
 /// overwritten.
 fn add_group(out: &mut [f64], terms: &[(f64, &SymmetricCsr)], first: bool) {
-    let value = |k: usize| (terms[k].0, &terms[k].1.values[..]);
-    match terms.len() {
-        1 => {
+    let n = out.len();
+    let value = |k: usize| (terms[k].0, &terms[k].1.values[..n]);
+    // The branches are taken once per call, so that each loop is a plain fused sum the
+    // compiler vectorizes.
+    match (terms.len(), first) {
+        (1, true) => {
             let (c0, a0) = value(0);
-            for (o, &x0) in out.iter_mut().zip(a0) {
-                *o = if first { c0 * x0 } else { *o + c0 * x0 };
+            for i in 0..n {
+                out[i] = c0 * a0[i];
             }
         }
-        2 => {
+        (1, false) => {
+            let (c0, a0) = value(0);
+            for i in 0..n {
+                out[i] += c0 * a0[i];
+            }
+        }
+        (2, true) => {
             let ((c0, a0), (c1, a1)) = (value(0), value(1));
-            for ((o, &x0), &x1) in out.iter_mut().zip(a0).zip(a1) {
-                let s = if first { c0 * x0 } else { *o + c0 * x0 };
-                *o = s + c1 * x1;
+            for i in 0..n {
+                out[i] = c0 * a0[i] + c1 * a1[i];
             }
         }
-        3 => {
+        (2, false) => {
+            let ((c0, a0), (c1, a1)) = (value(0), value(1));
+            for i in 0..n {
+                out[i] = out[i] + c0 * a0[i] + c1 * a1[i];
+            }
+        }
+        (3, true) => {
             let ((c0, a0), (c1, a1), (c2, a2)) = (value(0), value(1), value(2));
-            for (((o, &x0), &x1), &x2) in out.iter_mut().zip(a0).zip(a1).zip(a2) {
-                let s = if first { c0 * x0 } else { *o + c0 * x0 };
-                *o = s + c1 * x1 + c2 * x2;
+            for i in 0..n {
+                out[i] = c0 * a0[i] + c1 * a1[i] + c2 * a2[i];
             }
         }
-        _ => {
+        (3, false) => {
+            let ((c0, a0), (c1, a1), (c2, a2)) = (value(0), value(1), value(2));
+            for i in 0..n {
+                out[i] = out[i] + c0 * a0[i] + c1 * a1[i] + c2 * a2[i];
+            }
+        }
+        (_, true) => {
             let ((c0, a0), (c1, a1), (c2, a2), (c3, a3)) = (value(0), value(1), value(2), value(3));
-            for ((((o, &x0), &x1), &x2), &x3) in out.iter_mut().zip(a0).zip(a1).zip(a2).zip(a3) {
-                let s = if first { c0 * x0 } else { *o + c0 * x0 };
-                *o = s + c1 * x1 + c2 * x2 + c3 * x3;
+            for i in 0..n {
+                out[i] = c0 * a0[i] + c1 * a1[i] + c2 * a2[i] + c3 * a3[i];
+            }
+        }
+        (_, false) => {
+            let ((c0, a0), (c1, a1), (c2, a2), (c3, a3)) = (value(0), value(1), value(2), value(3));
+            for i in 0..n {
+                out[i] = out[i] + c0 * a0[i] + c1 * a1[i] + c2 * a2[i] + c3 * a3[i];
             }
         }
     }
