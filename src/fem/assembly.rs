@@ -343,4 +343,4 @@ pub fn lumped_masses_of(mesh: &Mesh, density: &dyn Fn(usize) -> f64) -> Vec<f64>
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

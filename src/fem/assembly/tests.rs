@@ -36,7 +36,7 @@ fn distorted_element(kind: ElementKind) -> Mesh {
 }
 
 /// Places every Hex20 or Tet10 mid-edge node at the midpoint of its edge's corners.
-fn straighten_edges(nodes: &mut [[f64; 3]], kind: ElementKind, element: &[usize]) {
+pub(crate) fn straighten_edges(nodes: &mut [[f64; 3]], kind: ElementKind, element: &[usize]) {
     if kind.is_quadratic() {
         for &(a, b, mid) in edges(kind) {
             let (pa, pb) = (nodes[element[a]], nodes[element[b]]);

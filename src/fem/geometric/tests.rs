@@ -1,7 +1,8 @@
 #![allow(clippy::needless_range_loop)] // index-heavy linear algebra reads clearer with indices
 
 use super::*;
-use crate::element::{corner_count, edges};
+use crate::element::corner_count;
+use crate::fem::assembly::tests::straighten_edges;
 use crate::fem::stiffness_matrix;
 use crate::mesh::beam;
 
@@ -22,18 +23,8 @@ fn distorted_block(kind: ElementKind) -> Mesh {
             p[2] += 0.02 * s * (1.0 - s);
         }
     }
-    if kind.is_quadratic() {
-        for e in 0..block.element_count() {
-            let element = block.element(e);
-            for &(a, b, mid) in edges(kind) {
-                let (pa, pb) = (nodes[element[a]], nodes[element[b]]);
-                nodes[element[mid]] = [
-                    0.5 * (pa[0] + pb[0]),
-                    0.5 * (pa[1] + pb[1]),
-                    0.5 * (pa[2] + pb[2]),
-                ];
-            }
-        }
+    for e in 0..block.element_count() {
+        straighten_edges(&mut nodes, kind, block.element(e));
     }
     let connectivity = (0..block.element_count())
         .flat_map(|e| block.element(e).to_vec())
