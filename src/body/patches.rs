@@ -42,6 +42,9 @@ pub struct Patch {
     stiffness: BlockCsr3,
     /// The patch's elements on its local nodes.
     mesh: Mesh,
+    /// The material of each of the patch's elements, in its order (material regions; no
+    /// stiffness inside a rigid set).
+    materials: Vec<IsotropicMaterial>,
     /// The geometric stiffness of the patch's own prestress ([`Patches::with_stiffening`]).
     stiffening: Option<SlabStiffening>,
 }
@@ -54,8 +57,6 @@ pub struct Patches {
     /// the iteration, see `solver::generalized_alpha`).
     pub node_patch: Vec<usize>,
     largest: usize,
-    /// The material of the slabs' prestress.
-    material: IsotropicMaterial,
     /// Whether the slabs' own stiffening ([`Patches::with_stiffening`]) is in their force.
     pub stiffening_active: bool,
     /// `ū_p` and `K_p ū_p` of [`Patches::update_stiffening`] (the largest patch's length).
@@ -98,10 +99,11 @@ fn principal_axis(mesh: &Mesh, lumped_masses: &[f64]) -> Vector3<f64> {
 impl Patches {
     /// Splits the elements of `mesh` into `count` slabs of equal length along the body's
     /// principal axis of least inertia (its longest direction), by element centroid; empty slabs
-    /// are dropped. `lumped_masses` (kg, positive) weight the patch frames.
+    /// are dropped. `lumped_masses` (kg, positive) weight the patch frames; `materials` holds
+    /// each element's material (its stiffness's: material regions, none inside a rigid set).
     pub fn along_principal_axis(
         mesh: &Mesh,
-        material: &IsotropicMaterial,
+        materials: &[IsotropicMaterial],
         lumped_masses: &[f64],
         count: usize,
     ) -> Result<Patches> {
@@ -132,7 +134,7 @@ impl Patches {
             groups[slot].push(e);
         }
         groups.retain(|g| !g.is_empty());
-        Self::from_groups(mesh, material, lumped_masses, groups)
+        Self::from_groups(mesh, materials, lumped_masses, groups)
     }
 
     /// The number of element layers along the body's principal axis of least inertia (as in
@@ -165,10 +167,11 @@ impl Patches {
         }
     }
 
-    /// Patches from groups of elements (each element in exactly one group).
+    /// Patches from groups of elements (each element in exactly one group), with each
+    /// element's material `materials[e]`.
     pub fn from_groups(
         mesh: &Mesh,
-        material: &IsotropicMaterial,
+        materials: &[IsotropicMaterial],
         lumped_masses: &[f64],
         groups: Vec<Vec<usize>>,
     ) -> Result<Patches> {
@@ -193,7 +196,9 @@ impl Patches {
                 mesh.kind(),
                 connectivity,
             )?;
-            let stiffness = BlockCsr3::from_csr(&fem::stiffness_matrix(&sub, material));
+            let materials: Vec<IsotropicMaterial> =
+                elements.iter().map(|&e| materials[e]).collect();
+            let stiffness = BlockCsr3::from_csr(&fem::stiffness_matrix_of(&sub, &|e| materials[e]));
             let weights = global.iter().map(|&n| lumped_masses[n]).collect();
             for &n in &global {
                 local[n] = usize::MAX;
@@ -203,6 +208,7 @@ impl Patches {
                 frame_weights: FrameWeights::new(global, weights, &reference),
                 stiffness,
                 mesh: sub,
+                materials,
                 stiffening: None,
             });
         }
@@ -223,7 +229,6 @@ impl Patches {
             patches,
             node_patch,
             largest,
-            material: *material,
             stiffening_active: false,
             update_scratch: (vec![0.0; 3 * largest], vec![0.0; 3 * largest]),
         })
@@ -234,7 +239,7 @@ impl Patches {
     /// docs/formulation.md, "Geometric stiffening within the slabs"). Set-up only (allocates).
     pub fn with_stiffening(mut self) -> Patches {
         for patch in &mut self.patches {
-            patch.stiffening = Some(SlabStiffening::new(&patch.mesh, &self.material));
+            patch.stiffening = Some(SlabStiffening::new(&patch.mesh, &patch.materials));
         }
         self
     }
@@ -414,7 +419,9 @@ mod tests {
     fn a_structured_beam_has_one_layer_per_element_along_it_and_one_slab_per_layer() {
         let (mesh, material, lumped) = beam();
         assert_eq!(Patches::element_layers(&mesh, &lumped), 6);
-        let slabs = Patches::along_principal_axis(&mesh, &material, &lumped, 6).unwrap();
+        let slabs =
+            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 6)
+                .unwrap();
         assert_eq!(slabs.len(), 6);
         assert!(slabs.patches.iter().all(|p| p.elements.len() == 1));
         // Across the beam (2 × 3 elements in the section) the layers still run along it.
@@ -426,7 +433,9 @@ mod tests {
     #[test]
     fn slabs_cover_every_element_once_and_their_stiffness_sums_to_k() {
         let (mesh, material, lumped) = beam();
-        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 3).unwrap();
+        let patches =
+            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 3)
+                .unwrap();
         assert_eq!(patches.len(), 3);
         let mut seen = vec![0; mesh.element_count()];
         for p in &patches.patches {
@@ -457,7 +466,9 @@ mod tests {
     #[test]
     fn force_is_the_gradient_of_the_energy_under_large_rotation() {
         let (mesh, material, lumped) = beam();
-        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 3).unwrap();
+        let patches =
+            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 3)
+                .unwrap();
         let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
         let q = nalgebra::Rotation3::from_euler_angles(0.4, -0.7, 1.1);
         // A bent configuration: y += 0.05 x², then rotated and shifted.
@@ -497,7 +508,9 @@ mod tests {
     #[test]
     fn rigid_motion_has_no_force() {
         let (mesh, material, lumped) = beam();
-        let patches = Patches::along_principal_axis(&mesh, &material, &lumped, 4).unwrap();
+        let patches =
+            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 4)
+                .unwrap();
         let q = nalgebra::Rotation3::from_euler_angles(2.0, 0.3, -1.0);
         let x: Vec<f64> = mesh
             .nodes()

@@ -29,20 +29,21 @@ struct ElementStiffening {
     unit: [Vec<f64>; 6],
     /// `Σ_k S̄_k G_k` of the last update (N/m), upper triangle row by row.
     values: Vec<f64>,
+    /// Lamé's `λ` and `μ` of the element's material (Pa).
+    lame: (f64, f64),
 }
 
 /// The geometric stiffness of one slab's own prestress (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct SlabStiffening {
     elements: Vec<ElementStiffening>,
-    /// Lamé's `λ` and `μ` (Pa).
-    lame: (f64, f64),
 }
 
 impl SlabStiffening {
     /// The stiffening of the slab whose elements are those of `mesh` (the slab's local nodes),
-    /// of `material`. Zero until the first [`Self::update`]. Set-up only (allocates).
-    pub fn new(mesh: &Mesh, material: &IsotropicMaterial) -> SlabStiffening {
+    /// element `e` of `materials[e]`. Zero until the first [`Self::update`]. Set-up only
+    /// (allocates).
+    pub fn new(mesh: &Mesh, materials: &[IsotropicMaterial]) -> SlabStiffening {
         let elements = (0..mesh.element_count())
             .map(|e| {
                 let (unit, mean_gradients) =
@@ -52,20 +53,18 @@ impl SlabStiffening {
                     mean_gradients,
                     values: vec![0.0; unit[0].len()],
                     unit,
+                    lame: (materials[e].lame_lambda(), materials[e].shear_modulus()),
                 }
             })
             .collect();
-        SlabStiffening {
-            elements,
-            lame: (material.lame_lambda(), material.shear_modulus()),
-        }
+        SlabStiffening { elements }
     }
 
     /// Refreshes `G_p` from the slab's local deformation `ubar` (m, flat over its local nodes).
     /// No allocation.
     pub fn update(&mut self, ubar: &[f64]) {
-        let (lambda, mu) = self.lame;
         for element in &mut self.elements {
+            let (lambda, mu) = element.lame;
             // grad[r][c] = ∂ū_r/∂X_c, the element's mean.
             let mut grad = [[0.0; 3]; 3];
             for (&a, g) in element.nodes.iter().zip(&element.mean_gradients) {
@@ -149,7 +148,7 @@ mod tests {
                 u
             })
             .collect();
-        let mut stiffening = SlabStiffening::new(&mesh, &material);
+        let mut stiffening = SlabStiffening::new(&mesh, &vec![material; mesh.element_count()]);
         stiffening.update(&ubar);
         let k_g = geometric_stiffness(&mesh, &stress_at_gauss_points(&mesh, &material, &ubar));
         let v: Vec<f64> = (0..ubar.len())

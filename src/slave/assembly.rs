@@ -149,6 +149,10 @@ impl Slave {
             },
             ..element_material(e)
         };
+        // The slabs' elements take the same materials as the body's elastic force.
+        let slab_materials: Vec<IsotropicMaterial> = (0..self.mesh.element_count())
+            .map(element_stiffness)
+            .collect();
         let mut lumped = fem::lumped_masses_of(&self.mesh, &density);
         let mut matrices = MeshMatrices {
             reference,
@@ -181,15 +185,21 @@ impl Slave {
             damping_beta: p.damping_beta,
         };
         let (body, clamped, reduced_stiffening) = if let Some(modes) = p.mode_count() {
-            self.reduced_body(&matrices, &lumped, options, modes)?
+            self.reduced_body(&matrices, &lumped, options, modes, &slab_materials)?
         } else {
             (
-                self.mesh_body(matrices, &lumped, options)?,
+                self.mesh_body(matrices, &lumped, options, &slab_materials)?,
                 self.clamped.clone(),
                 None,
             )
         };
-        self.finish_model(key, body, clamped, &lumped, reduced_stiffening)
+        self.finish_model(
+            key,
+            body,
+            clamped,
+            (&lumped, &slab_materials),
+            reduced_stiffening,
+        )
     }
 
     /// For each interface, whether it is a rigid attachment (a force interface, pin or hinge
@@ -234,6 +244,7 @@ impl Slave {
         matrices: MeshMatrices,
         lumped: &[f64],
         options: BodyOptions,
+        slab_materials: &[IsotropicMaterial],
     ) -> Result<Body> {
         for interface in &mut self.interfaces {
             interface.set.set_reduction(None);
@@ -267,7 +278,7 @@ impl Slave {
             let total = body.node_count();
             let mut slabs = Patches::along_principal_axis(
                 &self.mesh,
-                &p.material,
+                slab_materials,
                 &lumped[..mesh_nodes],
                 p.frames as usize,
             )?
@@ -292,6 +303,7 @@ impl Slave {
         lumped: &[f64],
         options: BodyOptions,
         modes: ModeCount,
+        slab_materials: &[IsotropicMaterial],
     ) -> Result<(Body, Vec<bool>, Option<GeometricStiffening>)> {
         self.check_reducible()?;
         // The sets' loads and motions are the mesh's while the basis is built (its attachment
@@ -330,7 +342,7 @@ impl Slave {
         let slabs = if p.frames > 1 {
             Some(Patches::along_principal_axis(
                 &self.mesh,
-                &p.material,
+                slab_materials,
                 &lumped[..mesh_nodes],
                 p.frames as usize,
             )?)
@@ -452,7 +464,7 @@ impl Slave {
         key: AssemblyKey,
         mut body: Body,
         clamped: Vec<bool>,
-        lumped: &[f64],
+        (lumped, slab_materials): (&[f64], &[IsotropicMaterial]),
         reduced_stiffening: Option<GeometricStiffening>,
     ) -> Result<()> {
         let started = std::time::Instant::now();
@@ -496,7 +508,7 @@ impl Slave {
             // 2.5 ms against `full` at 2.5 ms; docs/formulation.md, "Geometric stiffening within
             // the slabs").
             body.patches = Some(
-                Patches::along_principal_axis(&self.mesh, &p.material, mesh_lumped, layers)?
+                Patches::along_principal_axis(&self.mesh, slab_materials, mesh_lumped, layers)?
                     .covering(body.node_count())
                     .with_stiffening(),
             );

@@ -35,8 +35,9 @@ impl Slave {
         }
     }
 
-    /// Material regions are supported by the reduced-strain body with one frame and no
-    /// stiffening only: anything else is an error naming what is not supported.
+    /// Material regions are supported by the reduced-strain body, with one frame or several
+    /// (each slab's elements with their own materials, as `model.auto`'s slabs), without
+    /// `model.stiffening`: anything else is an error naming what is not supported.
     pub(super) fn check_regions(&self) -> Result<()> {
         let (p, regions) = (&self.parameters, &self.body_file.regions);
         if regions.is_empty() {
@@ -46,8 +47,6 @@ impl Slave {
             Some("model.formulation = full")
         } else if p.stiffening != Stiffening::None {
             Some("model.stiffening other than none")
-        } else if p.frames > 1 {
-            Some("model.frames > 1")
         } else if !p.output_directory.is_empty() {
             Some("output.directory (the stress output uses one material)")
         } else {
@@ -55,7 +54,7 @@ impl Slave {
         };
         match unsupported {
             Some(what) => Err(Error::new(format!(
-                "material regions ('{}'{}) are supported by the reduced-strain body with one frame and no stiffening only, not with {what}",
+                "material regions ('{}'{}) are supported by the reduced-strain body (one frame or several) without stiffening only, not with {what}",
                 regions[0].name,
                 if regions.len() > 1 { ", ..." } else { "" }
             ))),
