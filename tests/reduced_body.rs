@@ -676,6 +676,25 @@ fn unsupported_combinations_are_errors_naming_the_parameter() {
         e.message.contains("'root'") && e.message.contains("Pin"),
         "{e}"
     );
+    // Inertial stiffening with several frames: the error does not send a reduced body to
+    // `stress`, which it has not either.
+    let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
+    s.setup_experiment(0.0, None, None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    for (name, value) in [
+        ("model.modes", 4.0),
+        ("model.frames", 2.0),
+        ("model.stiffening", 2.0),
+    ] {
+        set(&mut s, name, value);
+    }
+    let e = s.exit_initialization_mode().unwrap_err();
+    assert!(
+        e.message.contains("model.frames = 2")
+            && e.message.contains("no stiffening")
+            && !e.message.contains("use model.stiffening = stress"),
+        "{e}"
+    );
     // Too many modes for the mesh.
     let mut s = Slave::from_body(BodyFile::default_body()).unwrap();
     s.setup_experiment(0.0, None, None).unwrap();

@@ -73,8 +73,14 @@ impl Slave {
             && p.stiffening == Stiffening::Inertial
             && p.formulation != Formulation::Full
         {
+            // `stress` is each slab's own prestress on the mesh; a reduced body has none.
+            let instead = if p.modes == 0 {
+                "with several frames use model.stiffening = stress, each slab's own prestress (docs/formulation.md, \"Geometric stiffening within the slabs\")"
+            } else {
+                "a reduced body with several frames takes no stiffening (model.stiffening = none)"
+            };
             return Err(Error::new(format!(
-                "model.stiffening = inertial with model.frames = {}: its unit load cases act on the one co-moving frame's deformation, which several frames replace; with several frames use model.stiffening = stress, each slab's own prestress (docs/formulation.md, \"Geometric stiffening within the slabs\")",
+                "model.stiffening = inertial with model.frames = {}: its unit load cases act on the one co-moving frame's deformation, which several frames replace; {instead}",
                 p.frames
             )));
         }
