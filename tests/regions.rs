@@ -11,6 +11,7 @@
 //! stay bounded: the energy never exceeds the work of the load.
 
 mod common;
+use common::rigid::largest_difference;
 use common::*;
 use flexbody::fem;
 use flexbody::linalg::SparseCholesky;
@@ -267,10 +268,7 @@ fn slabs_take_each_elements_material() {
     let one = tip_history(F, 30, &[]);
     let slabs = tip_history(F, 30, &[("model.frames", 4.0)]);
     let peak = one.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-    let largest = one
-        .iter()
-        .zip(&slabs)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    let largest = largest_difference(&one, &slabs);
     println!(
         "peak {peak:.4e} m, slabs against one frame {largest:.3e} m ({:.2e} of the peak)",
         largest / peak
@@ -307,10 +305,7 @@ fn auto_slabs_come_on_with_the_regions_materials() {
     let switch = log.iter().find(|m| m.contains("co-moving frames (slabs"));
     println!("{switch:?}");
     let peak = forced.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-    let largest = auto
-        .iter()
-        .zip(&forced)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    let largest = largest_difference(&auto, &forced);
     println!(
         "peak {peak:.4e} m, auto against forced slabs {largest:.3e} m ({:.2e} of the peak)",
         largest / peak
