@@ -415,13 +415,17 @@ mod tests {
         (mesh, material, lumped)
     }
 
+    /// The beam's slabs, `count` of them, every element of `material`.
+    fn slabs(mesh: &Mesh, material: IsotropicMaterial, lumped: &[f64], count: usize) -> Patches {
+        let materials = vec![material; mesh.element_count()];
+        Patches::along_principal_axis(mesh, &materials, lumped, count).unwrap()
+    }
+
     #[test]
     fn a_structured_beam_has_one_layer_per_element_along_it_and_one_slab_per_layer() {
         let (mesh, material, lumped) = beam();
         assert_eq!(Patches::element_layers(&mesh, &lumped), 6);
-        let slabs =
-            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 6)
-                .unwrap();
+        let slabs = slabs(&mesh, material, &lumped, 6);
         assert_eq!(slabs.len(), 6);
         assert!(slabs.patches.iter().all(|p| p.elements.len() == 1));
         // Across the beam (2 × 3 elements in the section) the layers still run along it.
@@ -433,9 +437,7 @@ mod tests {
     #[test]
     fn slabs_cover_every_element_once_and_their_stiffness_sums_to_k() {
         let (mesh, material, lumped) = beam();
-        let patches =
-            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 3)
-                .unwrap();
+        let patches = slabs(&mesh, material, &lumped, 3);
         assert_eq!(patches.len(), 3);
         let mut seen = vec![0; mesh.element_count()];
         for p in &patches.patches {
@@ -466,9 +468,7 @@ mod tests {
     #[test]
     fn force_is_the_gradient_of_the_energy_under_large_rotation() {
         let (mesh, material, lumped) = beam();
-        let patches =
-            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 3)
-                .unwrap();
+        let patches = slabs(&mesh, material, &lumped, 3);
         let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
         let q = nalgebra::Rotation3::from_euler_angles(0.4, -0.7, 1.1);
         // A bent configuration: y += 0.05 x², then rotated and shifted.
@@ -508,9 +508,7 @@ mod tests {
     #[test]
     fn rigid_motion_has_no_force() {
         let (mesh, material, lumped) = beam();
-        let patches =
-            Patches::along_principal_axis(&mesh, &vec![material; mesh.element_count()], &lumped, 4)
-                .unwrap();
+        let patches = slabs(&mesh, material, &lumped, 4);
         let q = nalgebra::Rotation3::from_euler_angles(2.0, 0.3, -1.0);
         let x: Vec<f64> = mesh
             .nodes()
