@@ -103,10 +103,14 @@ impl LowestModes {
         }
     }
 
-    /// `G_jl = φ_jᵀ A φ_l` of a symmetric matrix `A` on the body's coordinates (`size` = `3N`)
-    /// over the kept modes (1/s² for a stiffness; zero past the computed modes). Allocates;
-    /// set-up only.
-    pub fn project_matrix(&self, a: &SymmetricCsr, size: usize) -> [[f64; MODES]; MODES] {
+    /// `G_jl = φ_jᵀ A φ_l` of a symmetric matrix `A` on the body's coordinates (`size` = `3N`),
+    /// given by its product `product(x, A x)`, over the kept modes (1/s² for a stiffness; zero
+    /// past the computed modes). Allocates; set-up only.
+    pub fn project_matrix(
+        &self,
+        product: impl Fn(&[f64], &mut [f64]),
+        size: usize,
+    ) -> [[f64; MODES]; MODES] {
         let full: Vec<Vec<f64>> = (0..self.omega_sq.len())
             .map(|j| {
                 let mut phi = vec![0.0; size];
@@ -120,7 +124,7 @@ impl LowestModes {
         let mut g = [[0.0; MODES]; MODES];
         let mut y = vec![0.0; size];
         for (l, phi_l) in full.iter().enumerate() {
-            a.mul_vec(phi_l, &mut y);
+            product(phi_l, &mut y);
             for (j, phi_j) in full.iter().enumerate() {
                 g[j][l] = crate::linalg::dot(phi_j, &y);
             }

@@ -458,7 +458,7 @@ impl Body {
             0.5 * dot(ubar, g)
         };
         if let Some(kg) = geometric_stiffness {
-            kg.mul_vec(ubar, &mut scratch.stiffening_force);
+            stiffening::geometric_stiffness_product(kg, ubar, &mut scratch.stiffening_force);
         }
 
         // A linear body's frame does not move: `ω̄ = 0`, `ċ = 0` and no `f_nl`.

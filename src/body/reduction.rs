@@ -334,16 +334,17 @@ impl Reduction {
         }
     }
 
-    /// The Galerkin projection `(S ⊗ I3)ᵀ (G ⊗ I3) (S ⊗ I3) = (Sᵀ G S) ⊗ I3` (`3s × 3s`, dense
-    /// pattern) of a symmetric mesh matrix `G ⊗ I3` (`3N × 3N`, the same scalar `G_ij` on the
-    /// diagonal of each 3×3 block: a geometric stiffness, `fem::geometric`) on the reduced
-    /// coordinates (docs/formulation.md, "The reduced body": geometric stiffening): one product
-    /// with the matrix per field, a third of the general projection's. Allocates; set-up only.
+    /// The Galerkin projection `(S ⊗ I3)ᵀ (G ⊗ I3) (S ⊗ I3) = (Sᵀ G S) ⊗ I3` of a symmetric mesh
+    /// matrix `G ⊗ I3` (`3N × 3N`, the same scalar `G_ij` on the diagonal of each 3×3 block: a
+    /// geometric stiffness, `fem::geometric`) on the reduced coordinates (docs/formulation.md,
+    /// "The reduced body": geometric stiffening), returned as its scalar factor `G_r = Sᵀ G S`
+    /// (`s × s`, every entry stored, [`SymmetricCsr::mul_nodes`] applies `G_r ⊗ I3`): one product
+    /// with the matrix per field, a third of the general projection's, and a ninth of the
+    /// entries of the `3s × 3s` matrix to sum and multiply in a step. Allocates; set-up only.
     pub fn project_geometric_stiffness(&self, a: &SymmetricCsr) -> SymmetricCsr {
         let (s, n) = (self.field_count, self.node_count);
-        let mut projected = DMatrix::<f64>::zeros(3 * s, 3 * s);
+        let mut projected = DMatrix::<f64>::zeros(s, s);
         let (mut u, mut au) = (vec![0.0; 3 * n], vec![0.0; 3 * n]);
-        let mut column = vec![0.0; s];
         for l in 0..s {
             // (G ⊗ I3) applied to the field `l` along x: `G S_l` in the x components.
             u.fill(0.0);
@@ -355,15 +356,9 @@ impl Reduction {
                 (0..n).all(|i| au[3 * i + 1] == 0.0 && au[3 * i + 2] == 0.0),
                 "project_geometric_stiffness: the matrix is not G ⊗ I3"
             );
-            column.fill(0.0);
             for i in 0..n {
-                for (c, &sik) in column.iter_mut().zip(self.row(i)) {
-                    *c += sik * au[3 * i];
-                }
-            }
-            for (k, &v) in column.iter().enumerate() {
-                for d in 0..3 {
-                    projected[(3 * k + d, 3 * l + d)] = v;
+                for (k, &sik) in self.row(i).iter().enumerate() {
+                    projected[(k, l)] += sik * au[3 * i];
                 }
             }
         }

@@ -26,6 +26,18 @@ use crate::linalg::SymmetricCsr;
 use crate::mesh::Mesh;
 use nalgebra::{Matrix3, Vector3};
 
+/// `f = K_G x` for `K_G` as [`GeometricStiffening::pattern`] holds it: the mesh's `3N × 3N`
+/// matrix, or a reduced body's scalar factor `G_r` of `K_G = G_r ⊗ I3`
+/// ([`Reduction::project_geometric_stiffness`]), told apart by the dimension (`s` against the
+/// `3s` coordinates of `x`). No allocation.
+pub fn geometric_stiffness_product(k_g: &SymmetricCsr, x: &[f64], f: &mut [f64]) {
+    if 3 * k_g.n == x.len() {
+        k_g.mul_nodes(x, f);
+    } else {
+        k_g.mul_vec(x, f);
+    }
+}
+
 /// Which prestress drives the stiffening.
 #[derive(Debug, Clone)]
 pub enum GeometricStiffening {
@@ -220,7 +232,8 @@ impl GeometricStiffening {
         }
     }
 
-    /// A zero matrix with the pattern of `K_G`: the mesh's, or a reduced body's dense one.
+    /// A zero matrix with the pattern of `K_G`: the mesh's (`3N × 3N`), or a reduced body's
+    /// scalar factor `G_r` of `K_G = G_r ⊗ I3` (`s × s`, dense; [`geometric_stiffness_product`]).
     pub fn pattern(&self, mesh: &Mesh) -> SymmetricCsr {
         match self {
             GeometricStiffening::Inertial { unit_cases, .. } => {

@@ -5,7 +5,7 @@ use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
 use crate::body::feature_indicators::FeatureIndicators;
 use crate::body::lowest_modes::{LowestModes, MODES};
-use crate::body::stiffening::GeometricStiffening;
+use crate::body::stiffening::{geometric_stiffness_product, GeometricStiffening};
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{
     Body, BodyOptions, InterfaceSets, LinearPlacement, MeshData, ModeCount, NodeSet, Patches,
@@ -577,7 +577,12 @@ impl Slave {
                 stiffening.unit_cases().map(|cases| {
                     cases
                         .iter()
-                        .map(|k| modes.project_matrix(k, body.reference.len()))
+                        .map(|k| {
+                            modes.project_matrix(
+                                |x, y| geometric_stiffness_product(k, x, y),
+                                body.reference.len(),
+                            )
+                        })
                         .collect()
                 })
             }
