@@ -9,6 +9,16 @@ pub fn skew(a: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
+/// `m ← m + a bᵀ`, written out (nalgebra's product of a column and a row goes through its
+/// general matrix product, a third of the best-fit frame's cost on a reduced body).
+fn add_outer(m: &mut Matrix3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) {
+    for c in 0..3 {
+        for r in 0..3 {
+            m[(r, c)] += a[r] * b[c];
+        }
+    }
+}
+
 /// The rigid field `t + θ × (x − c)` nearest to a field `f` over `nodes` in the weighted
 /// least-squares sense, `Σ_i w_i |t + θ × (x_i − c) − f_i|²` (weights `weight(k) ≥ 0` of the
 /// `k`-th of `nodes`, positions `x` flat `3N`): `c` and `t` the weighted means of `x_i` and
@@ -231,7 +241,7 @@ impl FrameWeights {
         let origin = self.centroid(x);
         let mut a = Matrix3::zeros();
         for (k, (&n, arm)) in self.nodes.iter().zip(&self.arms).enumerate() {
-            a += (node(x, n) - self.unit(k) * origin) * arm.transpose();
+            add_outer(&mut a, &(node(x, n) - self.unit(k) * origin), arm);
         }
         Frame {
             origin,
@@ -243,13 +253,16 @@ impl FrameWeights {
     /// weighted inertia tensor; docs/formulation.md, "The internal force"). It maps the frame's rotation variation:
     /// `H δθ = −Σ w_i X̄_i × Rᵀ δx_i` (body-frame `δθ`).
     pub fn rotation_sensitivity(&self, frame: &Frame, x: &[f64]) -> Matrix3<f64> {
-        let mut h = Matrix3::zeros();
+        // [a]× [y]× = y aᵀ − (a · y) I: the sum of the outer products and of the dot products.
+        let mut outer = Matrix3::zeros();
+        let mut dots = 0.0;
         for (k, (&n, arm)) in self.nodes.iter().zip(&self.arms).enumerate() {
             // X̄_i + ū_i
             let y = frame.rotation.transpose() * (node(x, n) - self.unit(k) * frame.origin);
-            h += skew(arm) * skew(&y);
+            add_outer(&mut outer, &y, arm);
+            dots += arm.dot(&y);
         }
-        h
+        outer - Matrix3::identity() * dots
     }
 
     /// Body-frame angular velocity of the best-fit frame, `ω̄ = −H⁻¹ Σ w_i X̄_i × Rᵀ ẋ_i`
