@@ -156,7 +156,8 @@ pub struct ForceScratch {
     strain_energy: f64,
     patch: Option<patches::PatchScratch>,
     /// A reduced body with patches: the expanded nodes' positions and their patch forces
-    /// (flat `3N` of the mesh each).
+    /// (flat `3N` of the mesh each), where the slabs act on the nodes (their own stiffening on,
+    /// [`Patches::acts_on_coordinates`]).
     expanded: Option<(Vec<f64>, Vec<f64>)>,
 }
 
@@ -281,7 +282,10 @@ impl Body {
     }
 
     /// The same body with several co-moving frames (see [`patches`]).
-    pub fn with_patches(mut self, patches: Patches) -> Body {
+    pub fn with_patches(mut self, mut patches: Patches) -> Body {
+        if let Some(reduction) = &self.reduction {
+            patches.reduce(reduction);
+        }
         self.patches = Some(patches);
         self
     }
@@ -437,8 +441,13 @@ impl Body {
             g.fill(0.0); // global frame
             let patch_scratch = scratch.patch.as_mut().expect("patch scratch");
             match (&self.reduction, scratch.expanded.as_mut()) {
-                // A reduced body's patches act on its expanded nodes (docs/formulation.md,
-                // "The reduced body": several frames): `x = (S ⊗ I3) q`, `f_q = (S ⊗ I3)ᵀ f`.
+                // A reduced body's slabs act on its coordinates (docs/formulation.md, "The
+                // reduced body": several frames)...
+                (Some(_), _) if patches.acts_on_coordinates() => {
+                    patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g)
+                }
+                // ...or, with their own stiffening, on its expanded nodes:
+                // `x = (S ⊗ I3) q`, `f_q = (S ⊗ I3)ᵀ f`.
                 (Some(reduction), Some((nodes, forces))) => {
                     reduction.expand_into(x, nodes);
                     forces.fill(0.0);

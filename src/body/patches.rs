@@ -21,11 +21,17 @@
 //! one patch is the single-frame body. The mass matrix stays constant and so does the
 //! iteration matrix: the body-frame factorization preconditions the patch forces, whose
 //! Jacobian differs from it by the patches' rotations relative to the body frame.
+//!
+//! On a reduced body the same force acts on the coordinates `q` ([`Patches::reduce`],
+//! [`ReducedSlab`]): each slab's frame, `ū_p` and `K_p` in terms of the fields, exactly the
+//! projection of the nodal force (docs/formulation.md, "The reduced body": several frames).
 
 use super::frame::{add_node, node, set_node, FrameWeights};
+use super::reduction::Reduction;
 use super::slab_stiffening::SlabStiffening;
 use crate::error::{Error, Result};
 use crate::fem::{self, IsotropicMaterial};
+use crate::linalg::dense::DenseSymmetric;
 use crate::linalg::sparse::BlockCsr3;
 use crate::mesh::Mesh;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
@@ -61,6 +67,21 @@ pub struct Patches {
     pub stiffening_active: bool,
     /// `ū_p` and `K_p ū_p` of [`Patches::update_stiffening`] (the largest patch's length).
     update_scratch: (Vec<f64>, Vec<f64>),
+    /// On a reduced body, the slabs on its coordinates ([`Patches::reduce`]; empty otherwise).
+    reduced: Vec<ReducedSlab>,
+}
+
+/// A slab on a reduced body's coordinates `q` (docs/formulation.md, "The reduced body":
+/// several frames): its best-fit frame in terms of `q` ([`Reduction::part_frame`]) and
+/// `K_rp = (S_p ⊗ I3)ᵀ K_p (S_p ⊗ I3)` (`3s × 3s`). On the slab's nodes `ū_p = (S_p ⊗ I3) ū_r`
+/// with `ū_r,k = R_pᵀ (q_k − e_k c_p) − (q_ref,k − e_k C_p)`, so the slab's force on the
+/// coordinates, `(S ⊗ I3)ᵀ` of its nodal force, is `(I ⊗ R_p)(K_rp ū_r − a_k × z_p)` with the
+/// frame's constant arms `a_k`, and `m̄_p = Σ_i ū_i × g_i = Σ_k ū_r,k × (K_rp ū_r)_k`: the
+/// nodal force projected, without expanding the nodes.
+#[derive(Debug, Clone)]
+struct ReducedSlab {
+    frame_weights: FrameWeights,
+    stiffness: DenseSymmetric,
 }
 
 /// Scratch of [`Patches::internal_force`]: `ū_p` and `g_p` of the largest patch, and the
@@ -231,6 +252,7 @@ impl Patches {
             largest,
             stiffening_active: false,
             update_scratch: (vec![0.0; 3 * largest], vec![0.0; 3 * largest]),
+            reduced: Vec::new(),
         })
     }
 
@@ -352,7 +374,9 @@ impl Patches {
 
     /// Adds the elastic force `f_i = Σ_p R_p (g_p,i − w_i X̄_p,i × z_p)` of positions `x` to `f`
     /// (global frame, N; `z_p = 0` without `nonlinear_forces`) and returns the strain energy
-    /// `V = Σ_p ½ ū_pᵀ K_p ū_p` (J). No allocation.
+    /// `V = Σ_p ½ ū_pᵀ K_p ū_p` (J). On a reduced body whose slabs are on its coordinates
+    /// ([`Patches::acts_on_coordinates`]), `x` and `f` are the coordinates `q` and the force on
+    /// them, the same as the nodal force's projection. No allocation.
     pub fn internal_force(
         &self,
         x: &[f64],
@@ -361,46 +385,144 @@ impl Patches {
         f: &mut [f64],
     ) -> f64 {
         let mut energy = 0.0;
+        if self.acts_on_coordinates() {
+            for (p, slab) in self.reduced.iter().enumerate() {
+                let fw = &slab.frame_weights;
+                let arm = |k: usize, z: &Vector3<f64>| fw.arms[k].cross(z);
+                let product = |u: &[f64], g: &mut [f64]| slab.stiffness.mul_vec(u, g);
+                energy += part_force(fw, product, arm, x, nonlinear_forces, scratch, p, f);
+            }
+            return energy;
+        }
         for (p, patch) in self.patches.iter().enumerate() {
             let fw = &patch.frame_weights;
-            let m = 3 * fw.nodes.len();
-            let ubar = &mut scratch.local_deformation[..m];
-            let g = &mut scratch.elastic_force[..m];
-            let frame = fw.best_fit(x);
-            scratch.rotations[p] = frame.rotation;
-            let rt = frame.rotation.transpose();
-            for (k, &n) in fw.nodes.iter().enumerate() {
-                let u = rt * (node(x, n) - frame.origin) - fw.reference_offsets[k];
-                set_node(ubar, k, &u);
-            }
-            patch.stiffness.mul_vec(ubar, g);
-            energy += 0.5 * crate::linalg::dot(ubar, g);
+            let arm = |k: usize, z: &Vector3<f64>| fw.weights[k] * fw.reference_offsets[k].cross(z);
+            let product = |u: &[f64], g: &mut [f64]| patch.stiffness.mul_vec(u, g);
             // The stiffening's force is a frozen-prestress term, as the one frame's `K_G ū`: it
             // adds nothing to the strain energy (the output `body.strainEnergy`, the error
-            // control's scale of the modes above the lowest).
-            if let Some(stiffening) = patch.stiffening.as_ref().filter(|_| self.stiffening_active) {
-                stiffening.add_force(ubar, g);
-            }
-            let z = if nonlinear_forces {
-                let mut mbar = Vector3::zeros();
-                for k in 0..fw.nodes.len() {
-                    mbar += node(ubar, k).cross(&node(g, k));
+            // control's scale of the modes above the lowest), so it comes after the energy.
+            let stiffening = patch.stiffening.as_ref().filter(|_| self.stiffening_active);
+            let add_stiffening = |u: &[f64], g: &mut [f64]| {
+                if let Some(stiffening) = stiffening {
+                    stiffening.add_force(u, g);
                 }
-                let h_inv = fw
-                    .rotation_sensitivity(&frame, x)
-                    .try_inverse()
-                    .unwrap_or_else(Matrix3::zeros);
-                h_inv.transpose() * mbar
-            } else {
-                Vector3::zeros()
             };
-            for (k, &n) in fw.nodes.iter().enumerate() {
-                let local = node(g, k) - fw.weights[k] * fw.reference_offsets[k].cross(&z);
-                add_node(f, n, &(frame.rotation * local));
-            }
+            energy += part_force_with(
+                fw,
+                product,
+                add_stiffening,
+                arm,
+                x,
+                nonlinear_forces,
+                scratch,
+                p,
+                f,
+            );
         }
         energy
     }
+
+    /// Puts the slabs on a reduced body's coordinates ([`ReducedSlab`]): from then on, while
+    /// their own stiffening is off, [`Patches::internal_force`] takes `q` and gives the force on
+    /// it, `P` products with `3s × 3s` matrices instead of the expansion to the nodes, every
+    /// slab's `K_p` and the projection back. Allocates; set-up only.
+    pub fn reduce(&mut self, reduction: &Reduction) {
+        self.reduced = self
+            .patches
+            .iter()
+            .map(|patch| {
+                let fw = &patch.frame_weights;
+                ReducedSlab {
+                    frame_weights: reduction.part_frame(&fw.nodes, &fw.weights),
+                    stiffness: reduction
+                        .project_part_matrix(&fw.nodes, |u, g| patch.stiffness.mul_vec(u, g)),
+                }
+            })
+            .collect();
+        self.largest = self.largest.max(reduction.field_count);
+    }
+
+    /// Whether [`Patches::internal_force`] acts on a reduced body's coordinates: the slabs are
+    /// on them ([`Patches::reduce`]) and their own stiffening, which is refreshed on the nodes,
+    /// is off.
+    pub fn acts_on_coordinates(&self) -> bool {
+        let stiffened = self.stiffening_active && self.has_stiffening();
+        !self.reduced.is_empty() && !stiffened
+    }
+}
+
+/// One part's force (a slab on the nodes or on a reduced body's coordinates): its best-fit
+/// frame `fw` of `x` (kept in `scratch.rotations[p]`), `ū`, `g = product(ū)`, `f_nl`'s
+/// `z = H⁻ᵀ Σ_k ū_k × g_k`, and `R (g_k − arm(k, z))` added to `f`; returns `½ ūᵀ g` (J).
+#[allow(clippy::too_many_arguments)]
+fn part_force(
+    fw: &FrameWeights,
+    product: impl Fn(&[f64], &mut [f64]),
+    arm: impl Fn(usize, &Vector3<f64>) -> Vector3<f64>,
+    x: &[f64],
+    nonlinear_forces: bool,
+    scratch: &mut PatchScratch,
+    p: usize,
+    f: &mut [f64],
+) -> f64 {
+    part_force_with(
+        fw,
+        product,
+        |_, _| {},
+        arm,
+        x,
+        nonlinear_forces,
+        scratch,
+        p,
+        f,
+    )
+}
+
+/// [`part_force`] with `extra(ū, g)` added to `g` after the energy is taken (the slabs' own
+/// stiffening).
+#[allow(clippy::too_many_arguments)]
+fn part_force_with(
+    fw: &FrameWeights,
+    product: impl Fn(&[f64], &mut [f64]),
+    extra: impl Fn(&[f64], &mut [f64]),
+    arm: impl Fn(usize, &Vector3<f64>) -> Vector3<f64>,
+    x: &[f64],
+    nonlinear_forces: bool,
+    scratch: &mut PatchScratch,
+    p: usize,
+    f: &mut [f64],
+) -> f64 {
+    let m = 3 * fw.nodes.len();
+    let ubar = &mut scratch.local_deformation[..m];
+    let g = &mut scratch.elastic_force[..m];
+    let frame = fw.best_fit(x);
+    scratch.rotations[p] = frame.rotation;
+    let rt = frame.rotation.transpose();
+    for (k, &n) in fw.nodes.iter().enumerate() {
+        let u = rt * (node(x, n) - fw.unit(k) * frame.origin) - fw.reference_offsets[k];
+        set_node(ubar, k, &u);
+    }
+    product(ubar, g);
+    let energy = 0.5 * crate::linalg::dot(ubar, g);
+    extra(ubar, g);
+    let z = if nonlinear_forces {
+        let mut mbar = Vector3::zeros();
+        for k in 0..fw.nodes.len() {
+            mbar += node(ubar, k).cross(&node(g, k));
+        }
+        let h_inv = fw
+            .rotation_sensitivity(&frame, x)
+            .try_inverse()
+            .unwrap_or_else(Matrix3::zeros);
+        h_inv.transpose() * mbar
+    } else {
+        Vector3::zeros()
+    };
+    for (k, &n) in fw.nodes.iter().enumerate() {
+        let local = node(g, k) - arm(k, &z);
+        add_node(f, n, &(frame.rotation * local));
+    }
+    energy
 }
 
 #[cfg(test)]

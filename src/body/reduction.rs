@@ -64,6 +64,7 @@
 use super::frame::{node, FrameWeights};
 use super::interface::{FieldBasis, HeldCoordinate, NodeSet};
 use crate::error::Result;
+use crate::linalg::dense::DenseSymmetric;
 use crate::linalg::{dot, SymmetricCsr};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
@@ -363,6 +364,61 @@ impl Reduction {
             }
         }
         dense_symmetric(&(0.5 * (&projected + projected.transpose())))
+    }
+
+    /// The best-fit frame of a part of the mesh (its `nodes` with `weights`, kg: a slab's) in
+    /// terms of `q`, as [`Reduction::frame_weights`] is the whole body's: `Σ_i w_i x_i X̄_iᵀ =
+    /// Σ_k q_k a_kᵀ` with the constant `a_k = Σ_i w_i S_ik X̄_i` over the part's nodes, `X̄_i` from
+    /// the part's weighted centroid (docs/formulation.md, "The reduced body": several frames).
+    /// Allocates; set-up only.
+    pub fn part_frame(&self, nodes: &[usize], weights: &[f64]) -> FrameWeights {
+        let mut part_weights = vec![0.0; self.node_count];
+        for (&i, &w) in nodes.iter().zip(weights) {
+            part_weights[i] = w;
+        }
+        expanded_frame(
+            &part_weights,
+            &self.mesh_reference,
+            &self.fields,
+            &self.reference,
+            &self.unit,
+        )
+    }
+
+    /// The projection `(S_p ⊗ I3)ᵀ A (S_p ⊗ I3)` (`3s × 3s`, dense) of a symmetric matrix `A`
+    /// on a part's `nodes` (flat `3n` in their order, given by its product `product(x, A x)`),
+    /// `S_p` the rows of `S` of those nodes: a slab's `K_p` as the reduced coordinates see it
+    /// (docs/formulation.md, "The reduced body": several frames). Allocates; set-up only.
+    pub fn project_part_matrix(
+        &self,
+        nodes: &[usize],
+        product: impl Fn(&[f64], &mut [f64]),
+    ) -> DenseSymmetric {
+        let s = self.field_count;
+        let (mut u, mut au) = (vec![0.0; 3 * nodes.len()], vec![0.0; 3 * nodes.len()]);
+        let mut projected = faer::Mat::<f64>::zeros(3 * s, 3 * s);
+        for l in 0..s {
+            for d in 0..3 {
+                for (k, &i) in nodes.iter().enumerate() {
+                    u[3 * k + d] = self.row(i)[l];
+                }
+                product(&u, &mut au);
+                for (k, &i) in nodes.iter().enumerate() {
+                    for (m, &sim) in self.row(i).iter().enumerate() {
+                        for e in 0..3 {
+                            projected[(3 * m + e, 3 * l + d)] += sim * au[3 * k + e];
+                        }
+                    }
+                }
+                for k in 0..nodes.len() {
+                    u[3 * k + d] = 0.0;
+                }
+            }
+        }
+        let symmetric = faer::Mat::<f64>::from_fn(3 * s, 3 * s, |r, c| {
+            0.5 * (projected[(r, c)] + projected[(c, r)])
+        });
+        DenseSymmetric::new(symmetric)
     }
 
     /// The expanded nodal vector `x_i = Σ_k S_ik q_k` (flat `3N`) of a reduced vector `q`

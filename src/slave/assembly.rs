@@ -450,7 +450,7 @@ impl Slave {
         }
         let mut body = Body::reduced(reduction, options);
         if let Some(slabs) = slabs {
-            // Several co-moving frames act on the expanded nodes (docs/formulation.md, "The
+            // Several co-moving frames act on the coordinates (docs/formulation.md, "The
             // reduced body"): the slabs the basis took its modal derivatives from.
             body = body.with_patches(slabs);
         }

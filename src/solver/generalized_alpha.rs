@@ -627,8 +627,8 @@ impl IterationMatrix {
         frame: &'a Matrix3<f64>,
         forces: &'a ResidualWorkspace,
     ) -> impl Fn(usize) -> Matrix3<f64> + 'a {
-        // (A reduced body's coordinates belong to no patch: its patches act on the expanded
-        // nodes.)
+        // (A reduced body's coordinates belong to no patch: each slab's force acts on all of
+        // them.)
         let patches = body.patches.as_ref().filter(|_| {
             self.constraint.is_none() && self.newton.is_none() && body.reduction.is_none()
         });
