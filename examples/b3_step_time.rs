@@ -12,7 +12,8 @@
 //!   stiffening from the driving motion);
 //! * the same with `model.auto = false` (the reduced body without stiffening, as it stood);
 //! * the defaults (the mesh body; `model.auto` takes one slab per element layer);
-//! * the mesh body with `model.frames = 10`.
+//! * the mesh body with `model.frames = 10`;
+//! * the reduced body with `model.frames = 10` (its slabs on its coordinates).
 //!
 //! The yardstick: `model.formulation = full` at the fixed step 2.5 ms, sampled every 10 ms.
 
@@ -102,7 +103,7 @@ fn main() {
         Some(H / 4.0),
     );
     let peak = reference.tip.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-    let rows: [(&str, Vec<(&str, f64)>); 4] = [
+    let rows: [(&str, Vec<(&str, f64)>); 5] = [
         (
             "the defaults + `model.modes = auto`",
             vec![("model.modes", -1.0)],
@@ -113,6 +114,10 @@ fn main() {
         ),
         ("the defaults (mesh, `model.auto`'s slabs)", vec![]),
         ("mesh, `model.frames = 10`", vec![("model.frames", 10.0)]),
+        (
+            "`model.modes = auto`, `model.frames = 10` (reduced, the slabs on its coordinates)",
+            vec![("model.modes", -1.0), ("model.frames", 10.0)],
+        ),
     ];
     let mut times: Vec<(Vec<f64>, Vec<f64>)> = vec![(Vec::new(), Vec::new()); rows.len()];
     let mut results: Vec<Option<(f64, u64)>> = vec![None; rows.len()];

@@ -361,7 +361,7 @@ fn a_change_of_step_on_the_spinning_beam_leaves_no_vibration() {
 }
 
 /// A reduced body takes several co-moving frames too (docs/formulation.md, "The reduced
-/// body"): its slabs act on the expanded nodes. On B3 (20 elements, the whole 20 s, fixed
+/// body"): its slabs act on its coordinates. On B3 (20 elements, the whole 20 s, fixed
 /// 10 ms) the reduced body with 8 modes and 20 slabs stays within 0.5 % of `full`'s peak (issue
 /// 17's bar; measured 7.6e-4, 1.6e-3 before the basis held the slabs' second order) as the mesh
 /// body with the same slabs does (8.7e-4), where the reduced body with one frame carries the one frame's

@@ -18,7 +18,7 @@ fn do_step_does_not_allocate_after_the_first_step() {
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.frames", 5.0)]);
     steps_do_not_allocate(&[("solver.andersonDepth", 0.0)]);
     steps_do_not_allocate(&[("model.nonlinearForces", 1.0), ("model.modes", 4.0)]);
-    // A reduced body's slabs act on its expanded nodes, in the force scratch.
+    // A reduced body's slabs act on its coordinates, in the patch scratch.
     steps_do_not_allocate(&[("model.modes", 4.0), ("model.frames", 5.0)]);
     // Radau IIA: the real Cholesky and the complex LU solves take their workspaces.
     steps_do_not_allocate(&[("solver.integrator", 3.0)]);

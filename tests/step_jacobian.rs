@@ -439,7 +439,7 @@ fn the_reduced_body_has_its_step_jacobian_too() {
     let worst = compared_from(&mut s, &saved, t, 1e-3, &outputs, &TIP_INPUTS, &deltas);
     assert!(worst < 2e-5, "reduced B1: {worst:e}");
     // With six slabs under 500 N (the tip 7 mm down; damped, β = 1 ms, 60 steps of 1 ms): the
-    // slabs act on the expanded nodes, and the linearised step's matrix stays in the body's frame
+    // slabs act on the coordinates, and the linearised step's matrix stays in the body's frame
     // as the step's own (a slab's rotation on a reduced coordinate, as before, left it
     // unconverged after 50 iterations; now 13–14).
     let mut s = initialized_default(&[

@@ -155,10 +155,6 @@ pub struct ForceScratch {
     /// formulation).
     strain_energy: f64,
     patch: Option<patches::PatchScratch>,
-    /// A reduced body with patches: the expanded nodes' positions and their patch forces
-    /// (flat `3N` of the mesh each), where the slabs act on the nodes (their own stiffening on,
-    /// [`Patches::acts_on_coordinates`]).
-    expanded: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl ForceScratch {
@@ -377,11 +373,6 @@ impl Body {
             stiffening_force: vec![0.0; n3],
             strain_energy: 0.0,
             patch: self.patches.as_ref().map(Patches::scratch),
-            expanded: self
-                .reduction
-                .as_ref()
-                .filter(|_| self.patches.is_some())
-                .map(|r| (vec![0.0; 3 * r.node_count], vec![0.0; 3 * r.node_count])),
         }
     }
 
@@ -440,28 +431,9 @@ impl Body {
         } else if let Some(patches) = &self.patches {
             g.fill(0.0); // global frame
             let patch_scratch = scratch.patch.as_mut().expect("patch scratch");
-            match (&self.reduction, scratch.expanded.as_mut()) {
-                // A reduced body's slabs act on its coordinates (docs/formulation.md, "The
-                // reduced body": several frames)...
-                (Some(_), _) if patches.acts_on_coordinates() => {
-                    patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g)
-                }
-                // ...or, with their own stiffening, on its expanded nodes:
-                // `x = (S ⊗ I3) q`, `f_q = (S ⊗ I3)ᵀ f`.
-                (Some(reduction), Some((nodes, forces))) => {
-                    reduction.expand_into(x, nodes);
-                    forces.fill(0.0);
-                    let energy = patches.internal_force(
-                        nodes,
-                        self.options.nonlinear_forces,
-                        patch_scratch,
-                        forces,
-                    );
-                    reduction.project_into(forces, g);
-                    energy
-                }
-                _ => patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g),
-            }
+            // A reduced body's slabs act on its coordinates (docs/formulation.md, "The reduced
+            // body": several frames; `Patches::reduce`).
+            patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g)
         } else {
             self.stiffness_product.mul_vec(ubar, g);
             0.5 * dot(ubar, g)

@@ -351,6 +351,10 @@ impl Patches {
         size: f64,
         f: &mut [f64],
     ) {
+        assert!(
+            !self.acts_on_coordinates(),
+            "Patches::second_order_force: the slabs act on a reduced body's coordinates"
+        );
         let dofs = reference.len();
         let largest = u[..dofs].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         f.fill(0.0);
@@ -422,11 +426,19 @@ impl Patches {
         energy
     }
 
-    /// Puts the slabs on a reduced body's coordinates ([`ReducedSlab`]): from then on, while
-    /// their own stiffening is off, [`Patches::internal_force`] takes `q` and gives the force on
-    /// it, `P` products with `3s × 3s` matrices instead of the expansion to the nodes, every
-    /// slab's `K_p` and the projection back. Allocates; set-up only.
+    /// Puts the slabs on a reduced body's coordinates ([`ReducedSlab`]): from then on
+    /// [`Patches::internal_force`] takes `q` and gives the force on it, `P` products with
+    /// `3s × 3s` matrices instead of the expansion to the nodes, every slab's `K_p` and the
+    /// projection back. Allocates; set-up only.
+    ///
+    /// Panics if the slabs have their own stiffening ([`Patches::with_stiffening`]), which is
+    /// refreshed on the nodes: a reduced body's slabs take none (`model.auto` takes no slabs for
+    /// it, and `model.stiffening = stress` is refused).
     pub fn reduce(&mut self, reduction: &Reduction) {
+        assert!(
+            !self.has_stiffening(),
+            "Patches::reduce: slabs with their own stiffening act on the nodes"
+        );
         self.reduced = self
             .patches
             .iter()
@@ -442,12 +454,10 @@ impl Patches {
         self.largest = self.largest.max(reduction.field_count);
     }
 
-    /// Whether [`Patches::internal_force`] acts on a reduced body's coordinates: the slabs are
-    /// on them ([`Patches::reduce`]) and their own stiffening, which is refreshed on the nodes,
-    /// is off.
+    /// Whether [`Patches::internal_force`] acts on a reduced body's coordinates
+    /// ([`Patches::reduce`]).
     pub fn acts_on_coordinates(&self) -> bool {
-        let stiffened = self.stiffening_active && self.has_stiffening();
-        !self.reduced.is_empty() && !stiffened
+        !self.reduced.is_empty()
     }
 }
 
