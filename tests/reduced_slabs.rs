@@ -3,6 +3,8 @@
 //! whose force on the coordinates is the projection of the nodal force with the same strain
 //! energy, and its geometric stiffness, kept as the scalar `G_r` of `K_G = G_r ⊗ I3`.
 
+mod common;
+use common::rigid::largest_difference;
 use flexbody::body::{InterfaceSets, MeshData, ModeCount, NodeSet, Patches, Reduction};
 use flexbody::fem::geometric::{geometric_stiffness, stress_at_gauss_points};
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
@@ -117,10 +119,7 @@ fn slabs_on_the_coordinates_give_the_projected_nodal_force() {
             &mut direct,
         );
         let largest = projected.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-        let difference = projected
-            .iter()
-            .zip(&direct)
-            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        let difference = largest_difference(&projected, &direct);
         println!(
             "turned {angle} rad, deformation {size}, f_nl {nonlinear_forces}: force {largest:.3e}, difference {difference:.3e}; energy {energy_nodes:.6e} J against {energy_coordinates:.6e} J"
         );
@@ -169,10 +168,7 @@ fn the_scalar_geometric_stiffness_is_the_projection_of_the_mesh_one() {
     let mut projected = vec![0.0; 3 * s];
     reduction.project_into(&k_g_x, &mut projected);
     let largest = projected.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-    let difference = projected
-        .iter()
-        .zip(&kronecker)
-        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    let difference = largest_difference(&projected, &kronecker);
     println!("G_r ⊗ I3 against the projection: {difference:.3e} of {largest:.3e}");
     // Round-off of sums over the nodes in another order.
     assert!(largest > 0.0);

@@ -394,7 +394,18 @@ impl Patches {
                 let fw = &slab.frame_weights;
                 let arm = |k: usize, z: &Vector3<f64>| fw.arms[k].cross(z);
                 let product = |u: &[f64], g: &mut [f64]| slab.stiffness.mul_vec(u, g);
-                energy += part_force(fw, product, arm, x, nonlinear_forces, scratch, p, f);
+                let no_extra = |_: &[f64], _: &mut [f64]| {};
+                energy += part_force(
+                    fw,
+                    product,
+                    no_extra,
+                    arm,
+                    x,
+                    nonlinear_forces,
+                    scratch,
+                    p,
+                    f,
+                );
             }
             return energy;
         }
@@ -411,7 +422,7 @@ impl Patches {
                     stiffening.add_force(u, g);
                 }
             };
-            energy += part_force_with(
+            energy += part_force(
                 fw,
                 product,
                 add_stiffening,
@@ -462,36 +473,12 @@ impl Patches {
 }
 
 /// One part's force (a slab on the nodes or on a reduced body's coordinates): its best-fit
-/// frame `fw` of `x` (kept in `scratch.rotations[p]`), `ū`, `g = product(ū)`, `f_nl`'s
-/// `z = H⁻ᵀ Σ_k ū_k × g_k`, and `R (g_k − arm(k, z))` added to `f`; returns `½ ūᵀ g` (J).
+/// frame `fw` of `x` (kept in `scratch.rotations[p]`), `ū`, `g = product(ū)`, then
+/// `extra(ū, g)` added to `g` after the energy is taken (the slabs' own stiffening), `f_nl`'s
+/// `z = H⁻ᵀ Σ_k ū_k × g_k`, and `R (g_k − arm(k, z))` added to `f`; returns `½ ūᵀ product(ū)`
+/// (J).
 #[allow(clippy::too_many_arguments)]
 fn part_force(
-    fw: &FrameWeights,
-    product: impl Fn(&[f64], &mut [f64]),
-    arm: impl Fn(usize, &Vector3<f64>) -> Vector3<f64>,
-    x: &[f64],
-    nonlinear_forces: bool,
-    scratch: &mut PatchScratch,
-    p: usize,
-    f: &mut [f64],
-) -> f64 {
-    part_force_with(
-        fw,
-        product,
-        |_, _| {},
-        arm,
-        x,
-        nonlinear_forces,
-        scratch,
-        p,
-        f,
-    )
-}
-
-/// [`part_force`] with `extra(ū, g)` added to `g` after the energy is taken (the slabs' own
-/// stiffening).
-#[allow(clippy::too_many_arguments)]
-fn part_force_with(
     fw: &FrameWeights,
     product: impl Fn(&[f64], &mut [f64]),
     extra: impl Fn(&[f64], &mut [f64]),
