@@ -4,66 +4,23 @@
 //! energy, and its geometric stiffness, kept as the scalar `G_r` of `K_G = G_r ⊗ I3`.
 
 mod common;
+use common::reduced_b1::B1;
 use common::rigid::largest_difference;
-use flexbody::body::{InterfaceSets, MeshData, ModeCount, NodeSet, Patches, Reduction};
+use flexbody::body::{Patches, Reduction};
 use flexbody::fem::geometric::{geometric_stiffness, stress_at_gauss_points};
-use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
-use flexbody::mesh::{Mesh, NodeSelector};
-use flexbody::model::BodyFile;
+use flexbody::fem::IsotropicMaterial;
 use nalgebra::{Rotation3, Vector3};
 
-/// B1's mesh reduced to 4 modes (root held, tip loaded) and its five slabs, on the nodes and on
+/// B1's reduction to 4 modes (root held, tip loaded) and its five slabs, on the nodes and on
 /// the coordinates.
 fn b1_with_slabs() -> (Reduction, Patches, Patches) {
-    let (mesh, reduction) = b1_reduced();
-    let material = IsotropicMaterial::STEEL;
-    let lumped = lumped_masses(&mesh, material.density);
-    let materials = vec![material; mesh.element_count()];
-    let on_nodes = Patches::along_principal_axis(&mesh, &materials, &lumped, 5).unwrap();
+    let b1 = B1::new();
+    let (_, _, reduction) = b1.reduced(&[&b1.root], &[&b1.tip], 4);
+    let materials = vec![IsotropicMaterial::STEEL; b1.mesh.element_count()];
+    let on_nodes = Patches::along_principal_axis(&b1.mesh, &materials, &b1.lumped, 5).unwrap();
     let mut on_coordinates = on_nodes.clone();
     on_coordinates.reduce(&reduction);
     (reduction, on_nodes, on_coordinates)
-}
-
-/// B1's mesh (steel) and its reduction to 4 modes, the root held, the tip loaded.
-fn b1_reduced() -> (Mesh, Reduction) {
-    let mesh = BodyFile::default_body().mesh.build(None).unwrap();
-    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
-    let material = IsotropicMaterial::STEEL;
-    let lumped = lumped_masses(&mesh, material.density);
-    let set = |name: &str, x: f64, point: Option<Vector3<f64>>| {
-        let nodes = NodeSelector::Plane {
-            point: [x, 0.0, 0.0],
-            normal: [1.0, 0.0, 0.0],
-            tolerance: None,
-        }
-        .select(&mesh)
-        .unwrap();
-        let weights = nodes.iter().map(|&i| lumped[i]).collect();
-        NodeSet::new(name, nodes, weights, &reference, point).unwrap()
-    };
-    let (root, tip) = (set("root", 0.0, None), set("tip", 1.0, Some(Vector3::x())));
-    let k = stiffness_matrix(&mesh, &material);
-    let ms = scalar_mass_matrix(&mesh, material.density);
-    let reduction = Reduction::new(
-        &MeshData {
-            reference: &reference,
-            mass: &ms,
-            stiffness: &k,
-            force_stiffness: None,
-            lumped: &lumped,
-            frame_weights: &lumped,
-            second_order_force: None,
-        },
-        &InterfaceSets {
-            held: &[&root],
-            rigid: &[],
-            loaded: &[&tip],
-        },
-        ModeCount::Fixed(4),
-    )
-    .unwrap();
-    (mesh, reduction)
 }
 
 /// The coordinates of the body turned by `angle` about a skew axis, moved, and deformed by a
@@ -142,7 +99,9 @@ fn slabs_on_the_coordinates_give_the_projected_nodal_force() {
 /// projection of the mesh's `K_G = G ⊗ I3` does: `(G_r ⊗ I3) v = (S ⊗ I3)ᵀ K_G (S ⊗ I3) v`.
 #[test]
 fn the_scalar_geometric_stiffness_is_the_projection_of_the_mesh_one() {
-    let (mesh, reduction) = b1_reduced();
+    let b1 = B1::new();
+    let (_, _, reduction) = b1.reduced(&[&b1.root], &[&b1.tip], 4);
+    let mesh = b1.mesh;
     // A prestress: the stress of a bending and stretching displacement of the beam.
     let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
     let u: Vec<f64> = reference

@@ -382,20 +382,7 @@ impl Body {
         if let Some(dense) = &self.dense_mass {
             return dense.mul_nodes(v, y);
         }
-        let ms = &self.mass_matrix;
-        for i in 0..ms.n {
-            let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-            for k in ms.row_ptr[i]..ms.row_ptr[i + 1] {
-                let j = ms.col_idx[k];
-                let m = ms.values[k];
-                a += m * v[3 * j];
-                b += m * v[3 * j + 1];
-                c += m * v[3 * j + 2];
-            }
-            y[3 * i] = a;
-            y[3 * i + 1] = b;
-            y[3 * i + 2] = c;
-        }
+        self.mass_matrix.mul_nodes(v, y);
     }
 
     /// The internal force `f = f_int + f_d` at positions `x` and velocities `v` (flat `3N`, N):

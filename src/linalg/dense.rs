@@ -64,16 +64,22 @@ impl DenseSymmetric {
     /// the 3-vectors `x_j`, one product of `A` with the `n × 3` matrix of the nodes. No
     /// allocation.
     pub fn mul_nodes(&self, x: &[f64], y: &mut [f64]) {
-        let n = self.dim();
-        matmul(
-            MatMut::from_row_major_slice_mut(y, n, 3),
-            Accum::Replace,
-            self.matrix.as_ref(),
-            MatRef::from_row_major_slice(x, n, 3),
-            1.0,
-            Par::Seq,
-        );
+        mul_nodes(self.matrix.as_ref(), x, y);
     }
+}
+
+/// `y = (A ⊗ I3) x` for a dense `n × n` matrix `A` and flat vectors of `n` nodes: one SIMD
+/// product of `A` with the `n × 3` (row-major) matrix of the nodes. No allocation.
+pub(crate) fn mul_nodes(a: MatRef<'_, f64>, x: &[f64], y: &mut [f64]) {
+    let n = a.nrows();
+    matmul(
+        MatMut::from_row_major_slice_mut(y, n, 3),
+        Accum::Replace,
+        a,
+        MatRef::from_row_major_slice(x, n, 3),
+        1.0,
+        Par::Seq,
+    );
 }
 
 #[cfg(test)]

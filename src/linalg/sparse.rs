@@ -1,8 +1,7 @@
 //! Symmetric sparse matrices in compressed-row storage (both triangles stored), the storage of
 //! `Ms` and `K`, with an allocation-free product.
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::MatRef;
 use nalgebra::DMatrix;
 
 /// A symmetric `n × n` sparse matrix, both triangles stored, rows sorted by column.
@@ -113,15 +112,7 @@ impl SymmetricCsr {
             "SymmetricCsr::mul_nodes: y has the wrong length"
         );
         if self.values.len() == n * n {
-            matmul(
-                MatMut::from_row_major_slice_mut(y, n, 3),
-                Accum::Replace,
-                MatRef::from_row_major_slice(&self.values, n, n),
-                MatRef::from_row_major_slice(x, n, 3),
-                1.0,
-                Par::Seq,
-            );
-            return;
+            return super::dense::mul_nodes(MatRef::from_row_major_slice(&self.values, n, n), x, y);
         }
         for (i, yi) in y.chunks_exact_mut(3).enumerate() {
             let (cols, values) = self.row(i);

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod b3;
+pub mod reduced_b1;
 pub mod rigid;
 
 use flexbody::model::BodyFile;
