@@ -3,10 +3,12 @@
 //! over the tip-face nodes with weights proportional to their HRZ-lumped masses; the tip
 //! deflection is the mean y-displacement of the tip-face nodes with the same weights.
 
+mod common;
+use common::face;
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;
-use flexbody::mesh::{beam, ElementKind, Mesh, NodeSelector};
+use flexbody::mesh::{beam, ElementKind, Mesh};
 
 const LENGTH: f64 = 1.0;
 const SIDE: f64 = 0.02;
@@ -19,16 +21,6 @@ const TIMOSHENKO: f64 = 1.19084e-3;
 const CONVERGED_3D: f64 = 0.9987 * EULER_BERNOULLI;
 /// First bending frequency (Hz), Euler–Bernoulli.
 const FIRST_BENDING_HZ: f64 = 16.71;
-
-fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
-    NodeSelector::Plane {
-        point: [x, 0.0, 0.0],
-        normal: [1.0, 0.0, 0.0],
-        tolerance: None,
-    }
-    .select(mesh)
-    .unwrap()
-}
 
 /// DOFs of all nodes not on the root face, ascending.
 fn free_dofs(mesh: &Mesh) -> Vec<usize> {

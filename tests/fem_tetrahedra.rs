@@ -4,12 +4,14 @@
 //! Meshes: `tests/data/*.msh`, made by `tests/data/make_meshes.py` (Gmsh). The tet4 meshes are
 //! the Kuhn-split boxes of `mesh::beam`.
 
+mod common;
+use common::face;
 use flexbody::element::{edges, integration_rule, physical_gradients, shape_functions};
 use flexbody::element::{mass_rule, MAX_NODES};
 use flexbody::fem::modal::lowest_eigenpairs;
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SparseCholesky;
-use flexbody::mesh::{beam, gmsh, ElementKind, Mesh, NodeSelector};
+use flexbody::mesh::{beam, gmsh, ElementKind, Mesh};
 
 const LENGTH: f64 = 1.0;
 const SIDE: f64 = 0.02;
@@ -21,16 +23,6 @@ fn data(name: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests/data")
         .join(name)
-}
-
-fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
-    NodeSelector::Plane {
-        point: [x, 0.0, 0.0],
-        normal: [1.0, 0.0, 0.0],
-        tolerance: None,
-    }
-    .select(mesh)
-    .unwrap()
 }
 
 /// DOFs of all nodes not on the root face x = 0, ascending.

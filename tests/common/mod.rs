@@ -5,6 +5,7 @@ pub mod b3;
 pub mod reduced_b1;
 pub mod rigid;
 
+use flexbody::mesh::{Mesh, NodeSelector};
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -13,6 +14,17 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 pub const B1_TIMOSHENKO_DEFLECTION: f64 = 1.19084e-3;
 /// First bending frequency of B1 (Euler–Bernoulli), Hz.
 pub const B1_FIRST_FREQUENCY: f64 = 16.710;
+
+/// The nodes of `mesh` on the plane `x = const` (a face of the beam).
+pub fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
+    NodeSelector::Plane {
+        point: [x, 0.0, 0.0],
+        normal: [1.0, 0.0, 0.0],
+        tolerance: None,
+    }
+    .select(mesh)
+    .unwrap()
+}
 
 pub fn vr(slave: &Slave, name: &str) -> u32 {
     slave

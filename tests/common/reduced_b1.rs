@@ -1,23 +1,13 @@
 //! B1 (the default cantilever) at the library level for the reduced body's tests: its mesh,
 //! lumped masses, root and tip node sets, and its reduction.
 
+use super::face;
 use flexbody::body::{InterfaceSets, MeshData, ModeCount, NodeSet, Reduction};
 use flexbody::fem::{lumped_masses, scalar_mass_matrix, stiffness_matrix, IsotropicMaterial};
 use flexbody::linalg::SymmetricCsr;
-use flexbody::mesh::{Mesh, NodeSelector};
+use flexbody::mesh::Mesh;
 use flexbody::model::BodyFile;
 use nalgebra::Vector3;
-
-/// The nodes of `mesh` on the plane `x = const` (a face of the beam).
-pub fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
-    NodeSelector::Plane {
-        point: [x, 0.0, 0.0],
-        normal: [1.0, 0.0, 0.0],
-        tolerance: None,
-    }
-    .select(mesh)
-    .unwrap()
-}
 
 /// B1 on the default mesh (hex20 20×2×2), root face clamped, 10 N in −y on the tip face.
 pub struct B1 {
