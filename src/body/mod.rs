@@ -152,8 +152,11 @@ pub struct ForceScratch {
     mass_times: Vec<f64>,
     stiffening_force: Vec<f64>,
     /// The strain energy of the last [`Body::internal_force`] call (J; NaN for the full
-    /// formulation).
+    /// formulation and without the elastic term).
     strain_energy: f64,
+    /// Whether the last call left the elastic term out ([`Body::internal_force_without_elastic`]):
+    /// `elastic_force` then holds no `K ū`.
+    elastic_left_out: bool,
     patch: Option<patches::PatchScratch>,
 }
 
@@ -163,8 +166,10 @@ impl ForceScratch {
         &self.local_deformation
     }
 
-    /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N).
+    /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N). Not after
+    /// [`Body::internal_force_without_elastic`] ([`Body::local_elastic_force`] computes it).
     pub fn elastic_force(&self) -> &[f64] {
+        debug_assert!(!self.elastic_left_out, "the elastic term was left out");
         &self.elastic_force
     }
 
@@ -292,15 +297,27 @@ impl Body {
         self.full.is_none() && self.patches.is_none()
     }
 
+    /// Completes the force scratch of a call that left the elastic term out
+    /// ([`Body::internal_force_without_elastic`]): `g = K ū` and the strain energy of its `ū`,
+    /// as [`Body::internal_force`] leaves them. Nothing to do otherwise. No allocation.
+    pub fn complete_elastic_force(&self, scratch: &mut ForceScratch) {
+        if scratch.elastic_left_out {
+            self.stiffness_product
+                .mul_vec(&scratch.local_deformation, &mut scratch.elastic_force);
+            scratch.strain_energy = 0.5 * dot(&scratch.local_deformation, &scratch.elastic_force);
+            scratch.elastic_left_out = false;
+        }
+    }
+
     /// `K ū` (N, co-moving frame) of the local deformation of the last
-    /// [`Body::internal_force`] call: the force scratch's own with one frame, else computed
-    /// into `y` (flat `3N`). No allocation.
+    /// [`Body::internal_force`] call: the force scratch's own with one frame, else (or when that
+    /// call left the elastic term out) computed into `y` (flat `3N`). No allocation.
     pub fn local_elastic_force<'a>(
         &self,
         scratch: &'a ForceScratch,
         y: &'a mut [f64],
     ) -> &'a [f64] {
-        if self.single_frame() {
+        if self.single_frame() && !scratch.elastic_left_out {
             scratch.elastic_force()
         } else {
             self.stiffness_product(scratch.local_deformation(), y);
@@ -372,6 +389,7 @@ impl Body {
             mass_times: vec![0.0; n3],
             stiffening_force: vec![0.0; n3],
             strain_energy: 0.0,
+            elastic_left_out: false,
             patch: self.patches.as_ref().map(Patches::scratch),
         }
     }
@@ -405,6 +423,36 @@ impl Body {
         scratch: &mut ForceScratch,
         f: &mut [f64],
     ) -> BodyKinematics {
+        self.internal_force_terms(x, v, geometric_stiffness, true, scratch, f)
+    }
+
+    /// [`Body::internal_force`] without its elastic term `hR K ū` (one frame, no `f_nl`), which
+    /// the generalized-α iteration folds into its solve (docs/formulation.md, "The stiffness
+    /// folded into the solve"): `ū` is computed, `K ū` is not, and the strain energy is NaN.
+    pub fn internal_force_without_elastic(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        geometric_stiffness: Option<&SymmetricCsr>,
+        scratch: &mut ForceScratch,
+        f: &mut [f64],
+    ) -> BodyKinematics {
+        assert!(
+            self.single_frame() && self.full.is_none() && !self.options.nonlinear_forces,
+            "only the one frame's linear elastic term can be left out"
+        );
+        self.internal_force_terms(x, v, geometric_stiffness, false, scratch, f)
+    }
+
+    fn internal_force_terms(
+        &self,
+        x: &[f64],
+        v: &[f64],
+        geometric_stiffness: Option<&SymmetricCsr>,
+        elastic: bool,
+        scratch: &mut ForceScratch,
+        f: &mut [f64],
+    ) -> BodyKinematics {
         let fw = &self.frame_weights;
         let frame = self.local_deformation(x, &mut scratch.local_deformation);
         let r = frame.rotation;
@@ -421,9 +469,12 @@ impl Body {
             // A reduced body's slabs act on its coordinates (docs/formulation.md, "The reduced
             // body": several frames; `Patches::reduce`).
             patches.internal_force(x, self.options.nonlinear_forces, patch_scratch, g)
-        } else {
+        } else if elastic {
             self.stiffness_product.mul_vec(ubar, g);
             0.5 * dot(ubar, g)
+        } else {
+            g.fill(0.0);
+            f64::NAN
         };
         if let Some(kg) = geometric_stiffness {
             stiffening::geometric_stiffness_product(kg, ubar, &mut scratch.stiffening_force);
@@ -531,6 +582,7 @@ impl Body {
             set_node(f, i, &global);
         }
         scratch.strain_energy = strain_energy;
+        scratch.elastic_left_out = !elastic;
         BodyKinematics {
             frame,
             angular_velocity_body,

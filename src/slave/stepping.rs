@@ -567,13 +567,13 @@ impl Slave {
                 .forces
                 .observe(&model.body, state, &mut self.scale_scratch);
         }
-        if let Some(modes) = self.model.as_ref().and_then(|m| m.lowest_modes.as_ref()) {
-            let model = self.model.as_ref().unwrap();
+        if let Some(model) = self.model.as_mut().filter(|m| m.lowest_modes.is_some()) {
+            let modes = model.lowest_modes.as_ref().unwrap();
             let dynamics = self.dynamics.as_mut().unwrap();
             observe_deformation(
                 &model.body,
                 modes,
-                &model.forces,
+                &mut model.forces,
                 &mut self.scale_scratch,
                 dynamics,
             );

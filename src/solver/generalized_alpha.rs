@@ -22,8 +22,8 @@ use super::anderson::{Anderson, DEFAULT_DEPTH};
 use super::constraints::ConstraintFactor;
 use super::fixed_point::{largest_correction, mix_update, Convergence};
 use super::problem::{
-    residual, DynamicState, FreeNodes, IterationSettings, ResidualWorkspace, StepProblem,
-    StepReport,
+    folded_residual, residual, DynamicState, FreeNodes, IterationSettings, ResidualWorkspace,
+    StepProblem, StepReport,
 };
 use super::woodbury::NonlinearForceCorrection;
 use crate::body::frame::{node, set_node};
@@ -83,6 +83,8 @@ pub struct IterationMatrix {
     pub scheme: GeneralizedAlpha,
     /// The coefficient of `M` in `S̄`, `c_m + c_d α` (1/s²).
     mass_coefficient: f64,
+    /// The coefficient of `K` in `S̄`, `1 + c_d β`.
+    stiffness_coefficient: f64,
     pub factor: SparseCholesky,
     workspace: SolveWorkspace,
     /// `Z = S̄⁻¹ Cᵀ` and the inverse Schur complement when there are point constraints.
@@ -273,6 +275,7 @@ impl IterationMatrix {
             step_size: h,
             scheme: *scheme,
             mass_coefficient: c_m + c_d * damping_alpha,
+            stiffness_coefficient: 1.0 + c_d * damping_beta,
             factor,
             workspace,
             constraint,
@@ -386,13 +389,21 @@ fn iterate(
     let linear = body.steps_linearly(forces.geometric_stiffness.is_some())
         && matrix.constraint.is_none()
         && matrix.newton.is_none();
+    // The one frame's elastic term folded into the solve (docs/formulation.md, "The stiffness
+    // folded into the solve"): the iteration's corrections without the product `K ū`.
+    let folded = !linear && matrix.folds_stiffness(body);
+    let kappa = matrix.mass_coefficient / matrix.stiffness_coefficient;
     for iteration in 1..=settings.max_iterations {
-        let kin = residual(body, free, state, loads, forces);
+        let kin = if folded {
+            folded_residual(body, free, state, loads, forces, kappa)
+        } else {
+            residual(body, free, state, loads, forces)
+        };
         if iteration == 1 {
             matrix.freeze_nonlinear_jacobian(body, free, &kin, &state.position, forces);
         }
         let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
-        let largest = matrix.plain_update(body, free, &frame, state, ws, forces);
+        let largest = matrix.plain_update(body, free, &frame, state, ws, forces, folded);
         let solved = linear
             && iteration == 1
             && LINEAR_SAFETY * matrix.linear_error_ratio * largest <= settings.absolute_tolerance;
@@ -570,6 +581,7 @@ impl IterationMatrix {
     /// (and no point constraints, whose Schur complement is built in the body frame, nor Newton)
     /// the frame of the node's patch, so that the matrix follows each part of a strongly bent
     /// body. Returns the largest position correction ([`largest_correction`]).
+    #[allow(clippy::too_many_arguments)]
     fn plain_update(
         &mut self,
         body: &Body,
@@ -578,6 +590,7 @@ impl IterationMatrix {
         state: &mut DynamicState,
         ws: &mut StepWorkspace,
         forces: &ResidualWorkspace,
+        folded: bool,
     ) -> f64 {
         let rotation = self.node_rotation(body, frame, forces);
         gather_iterate(free, state, &mut ws.iterate);
@@ -587,6 +600,16 @@ impl IterationMatrix {
         }
         self.factor
             .solve_in_place(&mut ws.reduced, &mut self.workspace);
+        if folded {
+            // S̄⁻¹ hRᵀ r = S̄⁻¹ hRᵀ r° + ū_F / k' (`folded_residual`).
+            let ubar = forces.force_scratch.local_deformation();
+            let inverse = 1.0 / self.stiffness_coefficient;
+            for (k, &i) in free.nodes.iter().enumerate() {
+                for d in 0..3 {
+                    ws.reduced[3 * k + d] += inverse * ubar[3 * i + d];
+                }
+            }
+        }
         if let Some(correction) = self.active_nonlinear(body) {
             correction.correct(&mut ws.reduced);
         }
@@ -619,6 +642,19 @@ impl IterationMatrix {
 }
 
 impl IterationMatrix {
+    /// Whether the iteration folds `body`'s elastic term into its solve ([`folded_residual`]):
+    /// the term must be the one frame's `hR K ū` with this matrix's `K` and `hR` the residual's
+    /// own frame, so one frame, no `f_nl` (its moment reads `K ū`), not the full formulation
+    /// and not Newton's tangent. A linear body stops at its first correction on the solve's
+    /// forward error, which the fold would change; it keeps the product.
+    fn folds_stiffness(&self, body: &Body) -> bool {
+        body.single_frame()
+            && body.full.is_none()
+            && body.linear.is_none()
+            && !body.options.nonlinear_forces
+            && self.newton.is_none()
+    }
+
     /// The rotation of node `i`'s rows in `hR S̄ hRᵀ`: its patch's frame with several frames
     /// (unconstrained, reduced strain), else the iteration's `frame`.
     fn node_rotation<'a>(

@@ -18,6 +18,7 @@
 //! with [`residual`] in a [`ResidualWorkspace`].
 
 use super::constraints::{add_constraint_forces, PointConstraint, RigidConstraint};
+use crate::body::frame::{add_node, node};
 use crate::body::{Body, BodyKinematics, ForceScratch};
 use crate::error::{Error, Result};
 use crate::linalg::SymmetricCsr;
@@ -308,6 +309,9 @@ pub struct ResidualWorkspace {
     pub(super) external: Vec<f64>,
     /// The inertia force `M ẍ` (full `3N`; scratch between residuals).
     pub(super) inertia: Vec<f64>,
+    /// [`folded_residual`]'s `ẍ − κ hR ū_F` and `K_FH ū_H` (full `3N`; scratch).
+    folded: Vec<f64>,
+    held_coupling: Vec<f64>,
     /// The body's force scratch: `ū`, `g` and the patch frames of the last residual.
     pub(super) force_scratch: ForceScratch,
     /// The geometric stiffness `K_G` of the current prestress (stiffening), if any: set by the
@@ -322,6 +326,8 @@ impl ResidualWorkspace {
             internal: vec![0.0; n3],
             external: vec![0.0; n3],
             inertia: vec![0.0; n3],
+            folded: vec![0.0; n3],
+            held_coupling: vec![0.0; n3],
             force_scratch: body.force_scratch(),
             geometric_stiffness: None,
         }
@@ -329,6 +335,13 @@ impl ResidualWorkspace {
 
     /// The body's force scratch: `ū`, `g` of the last residual.
     pub fn force_scratch(&self) -> &ForceScratch {
+        &self.force_scratch
+    }
+
+    /// The force scratch with `g = K ū` of the last residual, computed once if that residual
+    /// was [`folded_residual`] ([`Body::complete_elastic_force`]).
+    pub fn completed_force_scratch(&mut self, body: &Body) -> &ForceScratch {
+        body.complete_elastic_force(&mut self.force_scratch);
         &self.force_scratch
     }
 
@@ -367,6 +380,18 @@ pub fn residual(
     ws.external.fill(0.0);
     loads(&state.position, &mut ws.external);
     body.mass_times(&state.acceleration, &mut ws.inertia);
+    add_inertia_loads_constraints(free, state, ws);
+    kin
+}
+
+/// `r ← r + M ẍ − f_ext(x) + Cᵀλ` with the internal force already in `ws.internal` and
+/// `M ẍ` (or what stands for it) in `ws.inertia`; `loads` have been evaluated into
+/// `ws.external`.
+fn add_inertia_loads_constraints(
+    free: &FreeNodes,
+    state: &DynamicState,
+    ws: &mut ResidualWorkspace,
+) {
     for k in 0..ws.internal.len() {
         ws.internal[k] += ws.inertia[k] - ws.external[k];
     }
@@ -377,6 +402,72 @@ pub fn residual(
         &state.multipliers,
         &mut ws.internal,
     );
+}
+
+/// The residual with the one frame's elastic term folded into the generalized-α solve
+/// (docs/formulation.md, "The stiffness folded into the solve"), for a body whose iteration
+/// matrix is `S = hR S̄ hRᵀ`, `S̄ = c' M + k' K` on the free DOFs `F` (held `H`), with the frame
+/// `R` of this residual. On the free DOFs it is
+///
+/// ```text
+/// r° = r − hR K_FF ū_F − κ hR M_FF ū_F,   κ = c'/k'
+///    = M (ẍ − κ hR ū⁰) + f'(x, ẋ) + hR K_FH ū_H + Cᵀλ − f_ext(x)
+/// ```
+///
+/// (`ū⁰`: `ū` with its held part zeroed; `f'` the internal force without `hR K ū`; `M`
+/// commutes with `hR`), so that `S̄⁻¹ hRᵀ r = S̄⁻¹ hRᵀ r° + ū_F / k'`: the solve gives the
+/// iteration's correction without the product `K ū`, for one product with `M` (which the
+/// inertia takes anyway) and `K`'s held columns. The held rows of `r°` are not the residual's.
+/// The force scratch holds `ū` but not `K ū` ([`Body::local_elastic_force`] computes it).
+pub fn folded_residual(
+    body: &Body,
+    free: &FreeNodes,
+    state: &DynamicState,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    ws: &mut ResidualWorkspace,
+    kappa: f64,
+) -> BodyKinematics {
+    let kin = body.internal_force_without_elastic(
+        &state.position,
+        &state.velocity,
+        ws.geometric_stiffness.as_ref(),
+        &mut ws.force_scratch,
+        &mut ws.internal,
+    );
+    ws.external.fill(0.0);
+    loads(&state.position, &mut ws.external);
+    let rotation = kin.frame.rotation;
+    let ubar = ws.force_scratch.local_deformation();
+    ws.folded.copy_from_slice(&state.acceleration);
+    for &i in &free.nodes {
+        add_node(&mut ws.folded, i, &(-kappa * (rotation * node(ubar, i))));
+    }
+    body.mass_times(&ws.folded, &mut ws.inertia);
+    // K_FH ū_H from K's held rows (K is symmetric), in the co-moving frame.
+    ws.held_coupling.fill(0.0);
+    for &i in &free.clamped {
+        for (j, &u) in ubar.iter().enumerate().skip(3 * i).take(3) {
+            let (columns, values) = body.stiffness_matrix.row(j);
+            if columns.len() == ws.held_coupling.len() {
+                // A full row (a reduced body's dense `K`): a contiguous axpy.
+                for (y, &k) in ws.held_coupling.iter_mut().zip(values) {
+                    *y += k * u;
+                }
+            } else {
+                for (&c, &k) in columns.iter().zip(values) {
+                    ws.held_coupling[c] += k * u;
+                }
+            }
+        }
+    }
+    for &i in &free.nodes {
+        add_node(
+            &mut ws.internal,
+            i,
+            &(rotation * node(&ws.held_coupling, i)),
+        );
+    }
+    add_inertia_loads_constraints(free, state, ws);
     kin
 }
 

@@ -211,7 +211,7 @@ impl Slave {
                 observe_deformation(
                     body,
                     modes,
-                    &model.forces,
+                    &mut model.forces,
                     &mut self.scale_scratch,
                     dynamics,
                 );
@@ -329,11 +329,11 @@ impl Slave {
 pub(super) fn observe_deformation(
     body: &crate::body::Body,
     modes: &LowestModes,
-    forces: &crate::solver::problem::ResidualWorkspace,
+    forces: &mut crate::solver::problem::ResidualWorkspace,
     y: &mut [f64],
     dynamics: &mut super::super::Dynamics,
 ) {
-    let scratch = forces.force_scratch();
+    let scratch = forces.completed_force_scratch(body);
     let elastic_force = body.local_elastic_force(scratch, y);
     // With patches the strain energy is theirs: the one frame's `ūᵀ K ū` holds its own
     // spurious strain of the slabs' turns (`θ²/2`, axial), an energy in the stiff modes that

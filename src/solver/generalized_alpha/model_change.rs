@@ -62,7 +62,7 @@ pub fn carry_over_force_change(
             *r -= old;
         }
         // (The body has no multipliers for the plain update to set.)
-        matrix.plain_update(body, free, &kin.frame.rotation, state, ws, forces);
+        matrix.plain_update(body, free, &kin.frame.rotation, state, ws, forces, false);
         let correction = &mut forces.external;
         correction.fill(0.0);
         for (k, &i) in free.nodes.iter().enumerate() {
