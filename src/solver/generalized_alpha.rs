@@ -98,7 +98,8 @@ pub struct IterationMatrix {
     linear_error_ratio: f64,
 }
 
-/// A linear step stops after its first correction `Δx₁` when `LINEAR_SAFETY × ρ × |Δx₁|` is
+/// A linear step stops after its first correction `Δx₁` when `LINEAR_SAFETY × ρ × |Δx₁|` (with
+/// the stiffness folded into the solve, `× (|Δx₁| + |ū_F| / k')`) is
 /// within the iteration's tolerance (`ρ`: [`forward_error_ratio`]): the forward error of the
 /// solve, about `cond(S̄) ε` of the correction, depends on the right-hand side; a tenth of the
 /// tolerance covers its spread.
@@ -391,7 +392,7 @@ fn iterate(
         && matrix.newton.is_none();
     // The one frame's elastic term folded into the solve (docs/formulation.md, "The stiffness
     // folded into the solve"): the iteration's corrections without the product `K ū`.
-    let folded = !linear && matrix.folds_stiffness(body);
+    let folded = matrix.folds_stiffness(body);
     let kappa = matrix.mass_coefficient / matrix.stiffness_coefficient;
     for iteration in 1..=settings.max_iterations {
         let kin = if folded {
@@ -404,9 +405,18 @@ fn iterate(
         }
         let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
         let largest = matrix.plain_update(body, free, &frame, state, ws, forces, folded);
+        // The solve's forward error is `ρ` of its solution, which folded is `Δx₁ − ū_F / k'`.
         let solved = linear
             && iteration == 1
-            && LINEAR_SAFETY * matrix.linear_error_ratio * largest <= settings.absolute_tolerance;
+            && LINEAR_SAFETY
+                * matrix.linear_error_ratio
+                * (largest
+                    + if folded {
+                        matrix.folded_size(free, forces)
+                    } else {
+                        0.0
+                    })
+                <= settings.absolute_tolerance;
         let converged = convergence.converged(largest)? || solved;
         if matrix.newton.is_none() {
             mix_update(&mut ws.anderson, converged, &ws.iterate, &mut ws.update);
@@ -645,14 +655,22 @@ impl IterationMatrix {
     /// Whether the iteration folds `body`'s elastic term into its solve ([`folded_residual`]):
     /// the term must be the one frame's `hR K ū` with this matrix's `K` and `hR` the residual's
     /// own frame, so one frame, no `f_nl` (its moment reads `K ū`), not the full formulation
-    /// and not Newton's tangent. A linear body stops at its first correction on the solve's
-    /// forward error, which the fold would change; it keeps the product.
+    /// and not Newton's tangent.
     fn folds_stiffness(&self, body: &Body) -> bool {
         body.single_frame()
             && body.full.is_none()
-            && body.linear.is_none()
             && !body.options.nonlinear_forces
             && self.newton.is_none()
+    }
+
+    /// `|ū_F|∞ / k'`: the part of a folded solve's solution that the correction does not hold
+    /// (a linear step's forward error is `ρ` of the whole solution).
+    fn folded_size(&self, free: &FreeNodes, forces: &ResidualWorkspace) -> f64 {
+        let ubar = forces.force_scratch.local_deformation();
+        let largest = free.nodes.iter().fold(0.0_f64, |m, &i| {
+            ubar[3 * i..3 * i + 3].iter().fold(m, |m, u| m.max(u.abs()))
+        });
+        largest / self.stiffness_coefficient
     }
 
     /// The rotation of node `i`'s rows in `hR S̄ hRᵀ`: its patch's frame with several frames
