@@ -20,7 +20,8 @@
 //!   `work_precision`'s B1 reference trajectory (CSV);
 //! * `bench/paired.py`: our reduced body (`reduced_run`) against Exudyn's CB-8 models, regular
 //!   and fast module, in interleaved paired rounds (2 s and 10 s simulated, setup apart, the
-//!   median of the rounds' ratios, two series that must agree);
+//!   median of the rounds' ratios, two series that must agree), each side's error its tip's
+//!   deviation from our mesh body at the same step;
 //! * `bench/plot.py`: the PNGs (work–precision, step scaling) and the summary of ratios at equal
 //!   error, which heads the report.
 //!
