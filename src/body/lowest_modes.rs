@@ -40,6 +40,10 @@ pub struct LowestModes {
     modes: Vec<f64>,
     /// `M φ_j`, stored as `modes` (kg^½).
     mass_modes: Vec<f64>,
+    /// `K φ_j` over all of the body's nodes, held ones included (node `i`, mode `j`, component
+    /// `c` at `3 (MODES i + j) + c`; N kg^-½ / m), when set ([`Self::with_stiffness_modes`]):
+    /// then `φ_jᵀ K ū` needs no product with `K`.
+    stiffness_modes: Option<Vec<f64>>,
     /// `ω_j²` (1/s²), ascending, positive; at most [`MODES`].
     omega_sq: Vec<f64>,
     /// `ω_top²` (1/s²): the lowest eigenvalue above the kept ones (the highest kept if none was
@@ -96,11 +100,40 @@ impl LowestModes {
             nodes: nodes.to_vec(),
             modes,
             mass_modes,
+            stiffness_modes: None,
             omega_sq,
             omega_top_sq,
             decay_rates,
             total_mass,
         }
+    }
+
+    /// The same with `K φ_j` stored (`product(x, K x)` on the body's `size = 3N` coordinates:
+    /// the body's own `K`, the one of its `K ū`), so that [`Self::deformation_of`] projects
+    /// `K ū` as `φ_jᵀ K ū = (K φ_j)ᵀ ū` (`K` symmetric) without the product. Allocates; set-up
+    /// only.
+    pub fn with_stiffness_modes(
+        mut self,
+        product: impl Fn(&[f64], &mut [f64]),
+        size: usize,
+    ) -> LowestModes {
+        let nodes = size / 3;
+        let mut stored = vec![0.0; 3 * MODES * nodes];
+        let (mut phi, mut k_phi) = (vec![0.0; size], vec![0.0; size]);
+        for j in 0..self.omega_sq.len() {
+            phi.fill(0.0);
+            for (k, &i) in self.nodes.iter().enumerate() {
+                let at = 3 * (MODES * k + j);
+                phi[3 * i..3 * i + 3].copy_from_slice(&self.modes[at..at + 3]);
+            }
+            product(&phi, &mut k_phi);
+            for i in 0..nodes {
+                let at = 3 * (MODES * i + j);
+                stored[at..at + 3].copy_from_slice(&k_phi[3 * i..3 * i + 3]);
+            }
+        }
+        self.stiffness_modes = Some(stored);
+        self
     }
 
     /// `G_jl = φ_jᵀ A φ_l` of a symmetric matrix `A` on the body's coordinates (`size` = `3N`),
@@ -236,6 +269,26 @@ impl LowestModes {
     /// mass norm squared is at most that over `ω_top²`. No allocation.
     pub fn deformation(&self, energy: f64, elastic_force: &[f64]) -> (f64, f64) {
         let p = self.project(&self.modes, &Matrix3::identity(), elastic_force);
+        self.deformation_from_projection(energy, &p)
+    }
+
+    /// [`Self::deformation`] from `ū` itself (flat `3N`, co-moving frame) with the stored
+    /// `K φ_j` ([`Self::with_stiffness_modes`]): `φ_jᵀ K ū = Σ_i (K φ_j)_iᵀ ū_i`, the same
+    /// projection without a product with `K` (with several frames `K ū` is no part of the
+    /// force, and `energy` comes from the slabs). `None` without the stored `K φ_j`. No
+    /// allocation.
+    pub fn deformation_of(&self, energy: f64, ubar: &[f64]) -> Option<(f64, f64)> {
+        let stored = self.stiffness_modes.as_ref()?;
+        let mut p = [0.0; MODES];
+        for (psi, u) in stored.chunks_exact(3 * MODES).zip(ubar.chunks_exact(3)) {
+            for (j, p) in p.iter_mut().enumerate() {
+                *p += psi[3 * j] * u[0] + psi[3 * j + 1] * u[1] + psi[3 * j + 2] * u[2];
+            }
+        }
+        Some(self.deformation_from_projection(energy, &p))
+    }
+
+    fn deformation_from_projection(&self, energy: f64, p: &[f64; MODES]) -> (f64, f64) {
         let (mut low, mut low_energy) = (0.0, 0.0);
         for (p, &w2) in p.iter().zip(&self.omega_sq) {
             low += p * p / (w2 * w2);
@@ -322,5 +375,34 @@ mod tests {
         // Above: the energy 0.72 J over ω_top² = 4 bounds the true 0.3² = 0.09 by 0.18.
         assert!((above - (0.18_f64 / 2.0).sqrt()).abs() < 1e-15);
         assert!(above >= (0.09_f64 / 2.0).sqrt());
+    }
+
+    #[test]
+    fn the_stored_stiffness_modes_project_k_u_without_the_product() {
+        // The two oscillators with a third node, held, to which node 1 is tied by its 4 N/m
+        // spring along x (K_FF as before), and 8 N/m along y at node 0 (a mode above the kept
+        // ones): `(K φ_j)ᵀ ū` must equal `φ_jᵀ (K ū)` with the held node's part of `K ū`.
+        let k = |x: &[f64], y: &mut [f64]| {
+            y.fill(0.0);
+            y[0] = x[0];
+            y[1] = 8.0 * x[1];
+            y[3] = 4.0 * (x[3] - x[6]);
+            y[6] = 4.0 * (x[6] - x[3]);
+        };
+        let modes = two_oscillators((0.0, 0.0)).with_stiffness_modes(k, 9);
+        let u = [0.5, 0.3, 0.0, 0.25, 0.0, 0.0, -0.1, 0.0, 0.0];
+        let mut g = [0.0; 9];
+        k(&u, &mut g);
+        let energy = crate::linalg::dot(&u, &g);
+        let from_product = modes.deformation(energy, &g);
+        let from_modes = modes.deformation_of(energy, &u).unwrap();
+        // Node 1's modal coordinate is g_x1 / 4 = u_x1 − u_x2 = 0.35, not u_x1: the held
+        // node counts.
+        assert!((from_product.0 - ((0.25_f64 + 0.1225) / 2.0).sqrt()).abs() < 1e-15);
+        assert!((from_modes.0 - from_product.0).abs() < 1e-15);
+        assert!((from_modes.1 - from_product.1).abs() < 1e-15);
+        assert!(two_oscillators((0.0, 0.0))
+            .deformation_of(energy, &u)
+            .is_none());
     }
 }

@@ -569,7 +569,17 @@ impl Slave {
             .then(|| {
                 schemes::lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta))
             })
-            .transpose()?;
+            .transpose()?
+            .map(|modes| {
+                // With slabs the deformation scale projects `K ū` from `K φ_j` (no product per
+                // step: `LowestModes::deformation_of`).
+                if body.patches.is_some() || parked_patches.is_some() {
+                    let size = body.reference.len();
+                    modes.with_stiffness_modes(|x, y| body.stiffness_product(x, y), size)
+                } else {
+                    modes
+                }
+            });
         let driven_stiffening = match (&lowest_modes, &stiffening) {
             (Some(modes), Some(stiffening))
                 if body.reduction.is_some() && self.decides_reduced_stiffening() =>
