@@ -8,8 +8,6 @@ mod common;
 
 use common::reduced_b1::B1;
 use flexbody::body::{Body, BodyOptions};
-use flexbody::fem::{self, IsotropicMaterial};
-use flexbody::mesh::{generator, ElementKind};
 use flexbody::solver::generalized_alpha::{GeneralizedAlpha, IterationMatrix};
 use flexbody::solver::problem::{
     folded_residual, last_residual, residual, DynamicState, FreeNodes, ResidualWorkspace,
@@ -114,16 +112,7 @@ fn assert_same(plain: &[f64], folded: &[f64], largest: f64) {
 
 #[test]
 fn a_mesh_body_folds_its_stiffness_into_the_solve() {
-    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex20).unwrap();
-    let material = IsotropicMaterial::STEEL;
-    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
-    let body = Body::new(
-        reference,
-        fem::scalar_mass_matrix(&mesh, material.density),
-        fem::stiffness_matrix(&mesh, &material),
-        fem::lumped_masses(&mesh, material.density),
-        options(),
-    );
+    let (mesh, body) = common::steel_beam(options());
     let clamped: Vec<bool> = mesh.nodes().iter().map(|p| p[0].abs() < 1e-9).collect();
     let free = FreeNodes::new(&body, &clamped);
     let (plain, folded, largest) = both_solves(&body, &free);

@@ -10,8 +10,6 @@
 mod common;
 use common::*;
 use flexbody::body::{Body, BodyOptions};
-use flexbody::fem::{self, IsotropicMaterial};
-use flexbody::mesh::{generator, ElementKind};
 use flexbody::solver::problem::{DynamicState, FreeNodes, IterationSettings, ResidualWorkspace};
 use flexbody::solver::radau::{self, RadauIIA, RadauMatrix, RadauProblem, RadauWorkspace};
 
@@ -24,16 +22,7 @@ struct Cantilever {
 }
 
 fn cantilever() -> Cantilever {
-    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex20).unwrap();
-    let material = IsotropicMaterial::STEEL;
-    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
-    let body = Body::new(
-        reference,
-        fem::scalar_mass_matrix(&mesh, material.density),
-        fem::stiffness_matrix(&mesh, &material),
-        fem::lumped_masses(&mesh, material.density),
-        BodyOptions::default(),
-    );
+    let (mesh, body) = steel_beam(BodyOptions::default());
     let clamped: Vec<bool> = mesh.nodes().iter().map(|p| p[0].abs() < 1e-9).collect();
     let tip = (0..mesh.node_count())
         .filter(|&i| (mesh.nodes()[i][0] - 1.0).abs() < 1e-9)

@@ -130,6 +130,16 @@ impl MatrixProduct {
     }
 }
 
+/// Whether [`Body::internal_force_of`] forms the elastic term `hR K ū`, or leaves it out for the
+/// generalized-α iteration to fold into its solve (docs/formulation.md, "The stiffness folded
+/// into the solve"; one frame, no `f_nl`): then `ū` is computed, `K ū` is not, and the strain
+/// energy is NaN.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ElasticTerm {
+    Included,
+    LeftOut,
+}
+
 /// What [`Body::internal_force`] finds on the way: the frame, its angular velocity and the
 /// strain energy.
 #[derive(Debug, Clone, Copy)]
@@ -154,7 +164,7 @@ pub struct ForceScratch {
     /// The strain energy of the last [`Body::internal_force`] call (J; NaN for the full
     /// formulation and without the elastic term).
     strain_energy: f64,
-    /// Whether the last call left the elastic term out ([`Body::internal_force_without_elastic`]):
+    /// Whether the last call left the elastic term out ([`ElasticTerm::LeftOut`]):
     /// `elastic_force` then holds no `K ū`.
     elastic_left_out: bool,
     patch: Option<patches::PatchScratch>,
@@ -167,7 +177,7 @@ impl ForceScratch {
     }
 
     /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N). Not after
-    /// [`Body::internal_force_without_elastic`] ([`Body::local_elastic_force`] computes it).
+    /// [`ElasticTerm::LeftOut`] ([`Body::local_elastic_force`] computes it).
     pub fn elastic_force(&self) -> &[f64] {
         debug_assert!(!self.elastic_left_out, "the elastic term was left out");
         &self.elastic_force
@@ -298,7 +308,7 @@ impl Body {
     }
 
     /// Completes the force scratch of a call that left the elastic term out
-    /// ([`Body::internal_force_without_elastic`]): `g = K ū` and the strain energy of its `ū`,
+    /// ([`ElasticTerm::LeftOut`]): `g = K ū` and the strain energy of its `ū`,
     /// as [`Body::internal_force`] leaves them. Nothing to do otherwise. No allocation.
     pub fn complete_elastic_force(&self, scratch: &mut ForceScratch) {
         if scratch.elastic_left_out {
@@ -423,36 +433,26 @@ impl Body {
         scratch: &mut ForceScratch,
         f: &mut [f64],
     ) -> BodyKinematics {
-        self.internal_force_terms(x, v, geometric_stiffness, true, scratch, f)
+        self.internal_force_of(ElasticTerm::Included, x, v, geometric_stiffness, scratch, f)
     }
 
-    /// [`Body::internal_force`] without its elastic term `hR K ū` (one frame, no `f_nl`), which
-    /// the generalized-α iteration folds into its solve (docs/formulation.md, "The stiffness
-    /// folded into the solve"): `ū` is computed, `K ū` is not, and the strain energy is NaN.
-    pub fn internal_force_without_elastic(
+    /// [`Body::internal_force`] with its elastic term `hR K ū` included or left out
+    /// ([`ElasticTerm`]).
+    pub fn internal_force_of(
         &self,
+        elastic: ElasticTerm,
         x: &[f64],
         v: &[f64],
         geometric_stiffness: Option<&SymmetricCsr>,
         scratch: &mut ForceScratch,
         f: &mut [f64],
     ) -> BodyKinematics {
+        let elastic = elastic == ElasticTerm::Included;
         assert!(
-            self.single_frame() && self.full.is_none() && !self.options.nonlinear_forces,
+            elastic
+                || (self.single_frame() && self.full.is_none() && !self.options.nonlinear_forces),
             "only the one frame's linear elastic term can be left out"
         );
-        self.internal_force_terms(x, v, geometric_stiffness, false, scratch, f)
-    }
-
-    fn internal_force_terms(
-        &self,
-        x: &[f64],
-        v: &[f64],
-        geometric_stiffness: Option<&SymmetricCsr>,
-        elastic: bool,
-        scratch: &mut ForceScratch,
-        f: &mut [f64],
-    ) -> BodyKinematics {
         let fw = &self.frame_weights;
         let frame = self.local_deformation(x, &mut scratch.local_deformation);
         let r = frame.rotation;

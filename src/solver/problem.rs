@@ -19,9 +19,10 @@
 
 use super::constraints::{add_constraint_forces, PointConstraint, RigidConstraint};
 use crate::body::frame::{add_node, node};
-use crate::body::{Body, BodyKinematics, ForceScratch};
+use crate::body::{Body, BodyKinematics, ElasticTerm, ForceScratch};
 use crate::error::{Error, Result};
 use crate::linalg::SymmetricCsr;
+use nalgebra::Matrix3;
 
 /// Which nodes move: the others are clamped (a `fixed` support) and keep their positions.
 #[derive(Debug, Clone)]
@@ -370,38 +371,7 @@ pub fn residual(
     loads: &dyn Fn(&[f64], &mut [f64]),
     ws: &mut ResidualWorkspace,
 ) -> BodyKinematics {
-    let kin = body.internal_force(
-        &state.position,
-        &state.velocity,
-        ws.geometric_stiffness.as_ref(),
-        &mut ws.force_scratch,
-        &mut ws.internal,
-    );
-    ws.external.fill(0.0);
-    loads(&state.position, &mut ws.external);
-    body.mass_times(&state.acceleration, &mut ws.inertia);
-    add_inertia_loads_constraints(free, state, ws);
-    kin
-}
-
-/// `r ← r + M ẍ − f_ext(x) + Cᵀλ` with the internal force already in `ws.internal` and
-/// `M ẍ` (or what stands for it) in `ws.inertia`; `loads` have been evaluated into
-/// `ws.external`.
-fn add_inertia_loads_constraints(
-    free: &FreeNodes,
-    state: &DynamicState,
-    ws: &mut ResidualWorkspace,
-) {
-    for k in 0..ws.internal.len() {
-        ws.internal[k] += ws.inertia[k] - ws.external[k];
-    }
-    add_constraint_forces(
-        &free.constraints,
-        &free.rigid,
-        &state.position,
-        &state.multipliers,
-        &mut ws.internal,
-    );
+    evaluate(body, free, state, loads, ws, None)
 }
 
 /// The residual with the one frame's elastic term folded into the generalized-α solve
@@ -427,7 +397,24 @@ pub fn folded_residual(
     ws: &mut ResidualWorkspace,
     kappa: f64,
 ) -> BodyKinematics {
-    let kin = body.internal_force_without_elastic(
+    evaluate(body, free, state, loads, ws, Some(kappa))
+}
+
+/// [`residual`] (`kappa` `None`) or [`folded_residual`].
+fn evaluate(
+    body: &Body,
+    free: &FreeNodes,
+    state: &DynamicState,
+    loads: &dyn Fn(&[f64], &mut [f64]),
+    ws: &mut ResidualWorkspace,
+    kappa: Option<f64>,
+) -> BodyKinematics {
+    let elastic = match kappa {
+        None => ElasticTerm::Included,
+        Some(_) => ElasticTerm::LeftOut,
+    };
+    let kin = body.internal_force_of(
+        elastic,
         &state.position,
         &state.velocity,
         ws.geometric_stiffness.as_ref(),
@@ -436,7 +423,33 @@ pub fn folded_residual(
     );
     ws.external.fill(0.0);
     loads(&state.position, &mut ws.external);
-    let rotation = kin.frame.rotation;
+    match kappa {
+        None => body.mass_times(&state.acceleration, &mut ws.inertia),
+        Some(kappa) => fold_stiffness(body, free, state, ws, &kin.frame.rotation, kappa),
+    }
+    for k in 0..ws.internal.len() {
+        ws.internal[k] += ws.inertia[k] - ws.external[k];
+    }
+    add_constraint_forces(
+        &free.constraints,
+        &free.rigid,
+        &state.position,
+        &state.multipliers,
+        &mut ws.internal,
+    );
+    kin
+}
+
+/// [`folded_residual`]'s terms in place of `hR K ū`: `M (ẍ − κ hR ū⁰)` into `ws.inertia`, and
+/// `hR K_FH ū_H` added to the internal force's free rows.
+fn fold_stiffness(
+    body: &Body,
+    free: &FreeNodes,
+    state: &DynamicState,
+    ws: &mut ResidualWorkspace,
+    rotation: &Matrix3<f64>,
+    kappa: f64,
+) {
     let ubar = ws.force_scratch.local_deformation();
     ws.folded.copy_from_slice(&state.acceleration);
     for &i in &free.nodes {
@@ -467,8 +480,6 @@ pub fn folded_residual(
             &(rotation * node(&ws.held_coupling, i)),
         );
     }
-    add_inertia_loads_constraints(free, state, ws);
-    kin
 }
 
 /// The residual left in `ws` by the last [`residual`] call.

@@ -5,7 +5,9 @@ pub mod b3;
 pub mod reduced_b1;
 pub mod rigid;
 
-use flexbody::mesh::{Mesh, NodeSelector};
+use flexbody::body::{Body, BodyOptions};
+use flexbody::fem::{self, IsotropicMaterial};
+use flexbody::mesh::{generator, ElementKind, Mesh, NodeSelector};
 use flexbody::model::BodyFile;
 use flexbody::slave::Slave;
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -14,6 +16,22 @@ use nalgebra::{Matrix3, Rotation3, Vector3};
 pub const B1_TIMOSHENKO_DEFLECTION: f64 = 1.19084e-3;
 /// First bending frequency of B1 (Euler–Bernoulli), Hz.
 pub const B1_FIRST_FREQUENCY: f64 = 16.710;
+
+/// The B1-like steel cantilever of the library-level tests (1 m × 20 mm × 20 mm, hex20
+/// 10×1×1, not yet clamped), its mesh and its body with `options`.
+pub fn steel_beam(options: BodyOptions) -> (Mesh, Body) {
+    let mesh = generator::beam(1.0, 0.02, 0.02, [10, 1, 1], ElementKind::Hex20).unwrap();
+    let material = IsotropicMaterial::STEEL;
+    let reference: Vec<f64> = mesh.nodes().iter().flatten().copied().collect();
+    let body = Body::new(
+        reference,
+        fem::scalar_mass_matrix(&mesh, material.density),
+        fem::stiffness_matrix(&mesh, &material),
+        fem::lumped_masses(&mesh, material.density),
+        options,
+    );
+    (mesh, body)
+}
 
 /// The nodes of `mesh` on the plane `x = const` (a face of the beam).
 pub fn face(mesh: &Mesh, x: f64) -> Vec<usize> {
