@@ -405,7 +405,8 @@ fn iterate(
         }
         let frame = matrix.iteration_frame(body, free, &kin, &state.position)?;
         let largest = matrix.plain_update(body, free, &frame, state, ws, forces, folded);
-        // The solve's forward error is `ρ` of its solution, which folded is `Δx₁ − ū_F / k'`.
+        // The solve's forward error is `ρ` of its solution, which folded is
+        // `−hRᵀ Δx₁ − ū_F / k'`.
         let solved = linear
             && iteration == 1
             && LINEAR_SAFETY
