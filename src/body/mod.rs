@@ -638,6 +638,28 @@ impl Body {
         self.stiffness_product.mul_vec(x, y);
     }
 
+    /// `y = K_·H x_H` (flat `3N`): `K`'s columns of the nodes `held` (ascending) times their
+    /// entries of `x` (docs/formulation.md, "The stiffness folded into the solve": `K_FH ū_H`).
+    /// A reduced body's held coordinates are its first fields, a contiguous block of its dense
+    /// `K`: one SIMD product; otherwise `K`'s held rows (it is symmetric). No allocation.
+    pub fn held_stiffness_product(&self, held: &[usize], x: &[f64], y: &mut [f64]) {
+        if let (MatrixProduct::Dense(k), Some(&first)) = (&self.stiffness_product, held.first()) {
+            if held.iter().enumerate().all(|(n, &i)| i == first + n) {
+                let columns = 3 * first..3 * (first + held.len());
+                return k.mul_columns(columns.clone(), &x[columns], y);
+            }
+        }
+        y.fill(0.0);
+        for &i in held {
+            for (j, &u) in x.iter().enumerate().skip(3 * i).take(3) {
+                let (columns, values) = self.stiffness_matrix.row(j);
+                for (&c, &k) in columns.iter().zip(values) {
+                    y[c] += k * u;
+                }
+            }
+        }
+    }
+
     /// Strain energy of positions `x` (J): `V = ½ ūᵀ K ū`, or the St. Venant–Kirchhoff energy
     /// of the full formulation; allocates (not for the hot path).
     pub fn strain_energy(&self, x: &[f64]) -> f64 {

@@ -60,6 +60,21 @@ impl DenseSymmetric {
         );
     }
 
+    /// `y = A[:, columns] x` (`x` of the columns' length, `y` of `n`): one SIMD product with
+    /// the contiguous block of columns. No allocation.
+    pub fn mul_columns(&self, columns: std::ops::Range<usize>, x: &[f64], y: &mut [f64]) {
+        let n = self.dim();
+        let block = self.matrix.as_ref().subcols(columns.start, columns.len());
+        matmul(
+            MatMut::from_column_major_slice_mut(y, n, 1),
+            Accum::Replace,
+            block,
+            MatRef::from_column_major_slice(x, columns.len(), 1),
+            1.0,
+            Par::Seq,
+        );
+    }
+
     /// `y = (A ⊗ I3) x` for flat vectors of `n` nodes (length `3n`): `y_i = Σ_j A_ij x_j` for
     /// the 3-vectors `x_j`, one product of `A` with the `n × 3` matrix of the nodes. No
     /// allocation.
@@ -107,6 +122,14 @@ mod tests {
         let (mut y, mut z) = (vec![0.0; 12], vec![0.0; 12]);
         a.mul_vec(&x, &mut y);
         dense.mul_vec(&x, &mut z);
+        for (p, q) in y.iter().zip(&z) {
+            assert!((p - q).abs() < 1e-14, "{p} {q}");
+        }
+        // A block of columns against the full product of a vector zero outside them.
+        let mut x_block = vec![0.0; 12];
+        x_block[3..7].copy_from_slice(&x[3..7]);
+        a.mul_vec(&x_block, &mut y);
+        dense.mul_columns(3..7, &x[3..7], &mut z);
         for (p, q) in y.iter().zip(&z) {
             assert!((p - q).abs() < 1e-14, "{p} {q}");
         }

@@ -456,23 +456,8 @@ fn fold_stiffness(
         add_node(&mut ws.folded, i, &(-kappa * (rotation * node(ubar, i))));
     }
     body.mass_times(&ws.folded, &mut ws.inertia);
-    // K_FH ū_H from K's held rows (K is symmetric), in the co-moving frame.
-    ws.held_coupling.fill(0.0);
-    for &i in &free.clamped {
-        for (j, &u) in ubar.iter().enumerate().skip(3 * i).take(3) {
-            let (columns, values) = body.stiffness_matrix.row(j);
-            if columns.len() == ws.held_coupling.len() {
-                // A full row (a reduced body's dense `K`): a contiguous axpy.
-                for (y, &k) in ws.held_coupling.iter_mut().zip(values) {
-                    *y += k * u;
-                }
-            } else {
-                for (&c, &k) in columns.iter().zip(values) {
-                    ws.held_coupling[c] += k * u;
-                }
-            }
-        }
-    }
+    // K_FH ū_H, in the co-moving frame.
+    body.held_stiffness_product(&free.clamped, ubar, &mut ws.held_coupling);
     for &i in &free.nodes {
         add_node(
             &mut ws.internal,
