@@ -177,7 +177,7 @@ impl ForceScratch {
     }
 
     /// `g = K ū` of the last [`Body::internal_force`] call (reduced strain; N). Not after
-    /// [`ElasticTerm::LeftOut`] ([`Body::local_elastic_force`] computes it).
+    /// [`ElasticTerm::LeftOut`] until [`Body::complete_elastic_force`].
     pub fn elastic_force(&self) -> &[f64] {
         debug_assert!(!self.elastic_left_out, "the elastic term was left out");
         &self.elastic_force
@@ -320,14 +320,14 @@ impl Body {
     }
 
     /// `K ū` (N, co-moving frame) of the local deformation of the last
-    /// [`Body::internal_force`] call: the force scratch's own with one frame, else (or when that
-    /// call left the elastic term out) computed into `y` (flat `3N`). No allocation.
+    /// [`Body::internal_force`] call: the force scratch's own with one frame (completed,
+    /// [`Body::complete_elastic_force`]), else computed into `y` (flat `3N`). No allocation.
     pub fn local_elastic_force<'a>(
         &self,
         scratch: &'a ForceScratch,
         y: &'a mut [f64],
     ) -> &'a [f64] {
-        if self.single_frame() && !scratch.elastic_left_out {
+        if self.single_frame() {
             scratch.elastic_force()
         } else {
             self.stiffness_product(scratch.local_deformation(), y);

@@ -388,7 +388,7 @@ pub fn residual(
 /// commutes with `hR`), so that `S̄⁻¹ hRᵀ r = S̄⁻¹ hRᵀ r° + ū_F / k'`: the solve gives the
 /// iteration's correction without the product `K ū`, for one product with `M` (which the
 /// inertia takes anyway) and `K`'s held columns. The held rows of `r°` are not the residual's.
-/// The force scratch holds `ū` but not `K ū` ([`Body::local_elastic_force`] computes it).
+/// The force scratch holds `ū` but not `K ū` ([`Body::complete_elastic_force`] computes it).
 pub fn folded_residual(
     body: &Body,
     free: &FreeNodes,
@@ -456,7 +456,10 @@ fn fold_stiffness(
         add_node(&mut ws.folded, i, &(-kappa * (rotation * node(ubar, i))));
     }
     body.mass_times(&ws.folded, &mut ws.inertia);
-    // K_FH ū_H, in the co-moving frame.
+    // K_FH ū_H, in the co-moving frame (none on a body that holds no node).
+    if free.clamped.is_empty() {
+        return;
+    }
     body.held_stiffness_product(&free.clamped, ubar, &mut ws.held_coupling);
     for &i in &free.nodes {
         add_node(

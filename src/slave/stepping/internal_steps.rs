@@ -339,23 +339,15 @@ pub(super) fn observe_deformation(
     // control (docs/formulation.md, "Time error control"). The lowest modes' part still comes
     // from the one frame's `K ū`, projected as `(K φ_j)ᵀ ū` without the product: a bound of
     // mixed origin, the rest taken as 0 where that part exceeds the frames' energy.
-    let patched = body.patches.as_ref().and_then(|_| {
-        let scratch = forces.force_scratch();
-        modes.deformation_of(2.0 * scratch.strain_energy(), scratch.local_deformation())
+    let scratch = forces.completed_force_scratch(body);
+    let patch_energy = body.patches.as_ref().map(|_| 2.0 * scratch.strain_energy());
+    let projected = patch_energy.and_then(|e| modes.deformation_of(e, scratch.local_deformation()));
+    let (low, above) = projected.unwrap_or_else(|| {
+        let elastic_force = body.local_elastic_force(scratch, y);
+        let energy = patch_energy
+            .unwrap_or_else(|| crate::linalg::dot(scratch.local_deformation(), elastic_force));
+        modes.deformation(energy, elastic_force)
     });
-    let (low, above) = match patched {
-        Some(scales) => scales,
-        None => {
-            let scratch = forces.completed_force_scratch(body);
-            let elastic_force = body.local_elastic_force(scratch, y);
-            let energy = if body.patches.is_some() {
-                2.0 * scratch.strain_energy()
-            } else {
-                crate::linalg::dot(scratch.local_deformation(), elastic_force)
-            };
-            modes.deformation(energy, elastic_force)
-        }
-    };
     dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
     dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
 }
