@@ -281,12 +281,20 @@ impl FrameWeights {
     /// `H` is singular). O(N), no allocation.
     pub fn moving_frame(&self, x: &[f64], v: &[f64]) -> (Frame, Vector3<f64>) {
         let frame = self.best_fit(x);
+        let omega = self.angular_velocity_at(&frame, x, v);
+        (frame, omega)
+    }
+
+    /// The body-frame angular velocity `ω̄` (rad/s) of `frame`, the best-fit frame of positions
+    /// `x`, at velocities `v` ([`Self::angular_velocity`] with `H⁻¹` from
+    /// [`Self::rotation_sensitivity`], taken as zero where `H` is singular). O(N), no
+    /// allocation.
+    pub fn angular_velocity_at(&self, frame: &Frame, x: &[f64], v: &[f64]) -> Vector3<f64> {
         let h_inv = self
-            .rotation_sensitivity(&frame, x)
+            .rotation_sensitivity(frame, x)
             .try_inverse()
             .unwrap_or_else(Matrix3::zeros);
-        let omega = self.angular_velocity(&frame, &h_inv, v);
-        (frame, omega)
+        self.angular_velocity(frame, &h_inv, v)
     }
 }
 

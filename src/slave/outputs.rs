@@ -187,7 +187,10 @@ fn body_outputs(body: &Body, state: &DynamicState, kin: &BodyKinematics, outputs
             .moving_frame(&state.position, &state.velocity);
         (frame.rotation, omega)
     } else {
-        (kin.frame.rotation, kin.angular_velocity_body)
+        let omega =
+            body.frame_weights
+                .angular_velocity_at(&kin.frame, &state.position, &state.velocity);
+        (kin.frame.rotation, omega)
     };
     let omega = r * omega_body;
     let strain_energy = match &body.full {
