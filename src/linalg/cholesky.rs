@@ -199,15 +199,9 @@ impl SparseCholesky {
             Par::Seq,
             MemStack::new(buffer),
         );
-        let inverse = self
-            .inverse
-            .get_or_insert_with(|| DenseSymmetric::new(Mat::zeros(n, n)));
-        let mut target = inverse.as_mut();
-        for j in 0..n {
-            for i in 0..n {
-                target[(i, j)] = 0.5 * (solves[(i, j)] + solves[(j, i)]);
-            }
-        }
+        self.inverse
+            .get_or_insert_with(|| DenseSymmetric::new(Mat::zeros(n, n)))
+            .assign_symmetrised(solves.as_ref());
     }
 
     /// Workspace for [`Self::solve_in_place`] (allocate once, reuse for every solve).

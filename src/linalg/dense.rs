@@ -3,15 +3,22 @@
 //! SIMD matrix–vector product replace the compressed storage of the mesh matrices, whose index
 //! per entry costs more than the product when every entry is stored (at `3s = 168`: 4.3 µs
 //! against 8.3 µs of [`super::sparse::BlockCsr3::mul_vec`], 1.5 µs against 5.2 µs for `Ms ⊗ I3`).
+//!
+//! `y = A x` itself reads only the upper triangle ([`UpperPanels`]): at these sizes the matrix
+//! lives in the L2 cache and the full product is bound by reading it, so reading half of it,
+//! each entry serving `y_i` and `y_j`, takes about half the time.
 
 use super::SymmetricCsr;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
+use pulp::{Arch, Simd, WithSimd};
 
 /// A dense symmetric `n × n` matrix.
 #[derive(Debug, Clone)]
 pub struct DenseSymmetric {
     matrix: Mat<f64>,
+    /// The upper triangle of `matrix`, for [`Self::mul_vec`].
+    upper: UpperPanels,
 }
 
 impl DenseSymmetric {
@@ -24,18 +31,30 @@ impl DenseSymmetric {
                 matrix[(i, j)] = v;
             }
         }
-        DenseSymmetric { matrix }
+        DenseSymmetric::new(matrix)
     }
 
     /// The dense matrix `m` (square, symmetric by the caller's construction).
     pub fn new(matrix: Mat<f64>) -> DenseSymmetric {
         assert_eq!(matrix.nrows(), matrix.ncols(), "DenseSymmetric: not square");
-        DenseSymmetric { matrix }
+        let upper = UpperPanels::new(matrix.as_ref());
+        DenseSymmetric { matrix, upper }
     }
 
-    /// The matrix, to overwrite in place (the caller keeps it symmetric).
-    pub fn as_mut(&mut self) -> MatMut<'_, f64> {
-        self.matrix.as_mut()
+    /// Overwrite the matrix with the symmetric `(m + mᵀ)/2` of a square `m` of the same
+    /// dimension. No allocation.
+    pub fn assign_symmetrised(&mut self, m: MatRef<'_, f64>) {
+        let n = self.dim();
+        assert!(
+            m.nrows() == n && m.ncols() == n,
+            "DenseSymmetric: dimension"
+        );
+        for j in 0..n {
+            for i in 0..n {
+                self.matrix[(i, j)] = 0.5 * (m[(i, j)] + m[(j, i)]);
+            }
+        }
+        self.upper.assign(self.matrix.as_ref());
     }
 
     /// Dimension `n`.
@@ -43,21 +62,11 @@ impl DenseSymmetric {
         self.matrix.nrows()
     }
 
-    /// `y = A x` (length `n`). No allocation. `A` is symmetric, so its column-major storage
-    /// is `Aᵀ` row-major: faer multiplies that with its dot-product kernel (each row against
-    /// `x`, the sums in registers) instead of the column kernel, which reads and writes all of
-    /// `y` once per column. B1's reduced linear step (`3s` = 129 and 138) takes 0.89 of the
-    /// time it took (median of 6 interleaved runs, bench/results/2026-11-27-paired-2.md).
+    /// `y = A x` (length `n`). No allocation. Reads the upper triangle once
+    /// ([`UpperPanels::mul_vec`]): B1's reduced solve with `A⁻¹` (`n` = 129) takes 1.0 µs
+    /// against 1.6 µs of faer's product with the whole matrix (a 200 000-fold loop, best of 5).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        let n = self.dim();
-        matmul(
-            MatMut::from_column_major_slice_mut(y, n, 1),
-            Accum::Replace,
-            self.matrix.as_ref().transpose(),
-            MatRef::from_column_major_slice(x, n, 1),
-            1.0,
-            Par::Seq,
-        );
+        self.upper.mul_vec(x, y);
     }
 
     /// `y = A[:, columns] x` (`x` of the columns' length, `y` of `n`): one SIMD product with
@@ -97,6 +106,137 @@ pub(crate) fn mul_nodes(a: MatRef<'_, f64>, x: &[f64], y: &mut [f64]) {
     );
 }
 
+/// The upper triangle of a symmetric `n × n` matrix `A`, stored for the product `y = A x` in
+/// panels of four rows: panel `p` holds rows `4p..4p + 4` from column `4p` to `n`, each row
+/// contiguous, with the entries left of the diagonal zero and the diagonal halved. Then the
+/// panel `B` (`4 × (n − 4p)`) gives `y_{4p..} += B x_{4p..}` (row sums) and
+/// `y_{4p..} += Bᵀ x_{4p..4p+4}` (the same entries read once for the symmetric half), and the
+/// two together add `A`'s rows `4p..4p+4` and their mirrored columns exactly once: the halved
+/// diagonal counted twice, the zeros not at all. Rows past `n` (the last panel's) are zero.
+#[derive(Debug, Clone)]
+struct UpperPanels {
+    n: usize,
+    /// The panels one after another; panel `p` starts at `offsets[p]`.
+    entries: Vec<f64>,
+    offsets: Vec<usize>,
+    /// The SIMD instruction set found at run time (`pulp`, faer's SIMD layer).
+    arch: Arch,
+}
+
+/// Rows per panel of [`UpperPanels`]: four accumulators and four broadcast values stay in
+/// registers beside the loaded column block.
+const PANEL_ROWS: usize = 4;
+
+impl UpperPanels {
+    fn new(a: MatRef<'_, f64>) -> UpperPanels {
+        let n = a.nrows();
+        let panels = n.div_ceil(PANEL_ROWS);
+        let mut offsets = Vec::with_capacity(panels);
+        let mut length = 0;
+        for p in 0..panels {
+            offsets.push(length);
+            length += PANEL_ROWS * (n - PANEL_ROWS * p);
+        }
+        let mut upper = UpperPanels {
+            n,
+            entries: vec![0.0; length],
+            offsets,
+            arch: Arch::new(),
+        };
+        upper.assign(a);
+        upper
+    }
+
+    /// Take the upper triangle of `a` (same dimension). No allocation.
+    fn assign(&mut self, a: MatRef<'_, f64>) {
+        let n = self.n;
+        for (p, &offset) in self.offsets.iter().enumerate() {
+            let start = PANEL_ROWS * p;
+            let width = n - start;
+            for r in 0..PANEL_ROWS {
+                let row = &mut self.entries[offset + r * width..offset + (r + 1) * width];
+                let i = start + r;
+                for (k, entry) in row.iter_mut().enumerate() {
+                    let j = start + k;
+                    *entry = if i >= n || j < i {
+                        0.0
+                    } else if j == i {
+                        0.5 * a[(i, i)]
+                    } else {
+                        a[(i, j)]
+                    };
+                }
+            }
+        }
+    }
+
+    /// `y = A x`, each stored entry read once. No allocation.
+    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        assert!(
+            x.len() == self.n && y.len() == self.n,
+            "UpperPanels: length"
+        );
+        self.arch.dispatch(PanelProduct { upper: self, x, y });
+    }
+}
+
+/// [`UpperPanels::mul_vec`] for one SIMD instruction set.
+struct PanelProduct<'a> {
+    upper: &'a UpperPanels,
+    x: &'a [f64],
+    y: &'a mut [f64],
+}
+
+impl WithSimd for PanelProduct<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: Simd>(self, simd: S) {
+        let PanelProduct { upper, x, y } = self;
+        let n = upper.n;
+        y.fill(0.0);
+        for (p, &offset) in upper.offsets.iter().enumerate() {
+            let start = PANEL_ROWS * p;
+            let width = n - start;
+            let panel = &upper.entries[offset..offset + PANEL_ROWS * width];
+            let (row0, rest) = panel.split_at(width);
+            let (row1, rest) = rest.split_at(width);
+            let (row2, row3) = rest.split_at(width);
+            let rows = [row0, row1, row2, row3];
+            // x_i of the panel's rows (0 past n).
+            let x_row: [f64; PANEL_ROWS] =
+                std::array::from_fn(|r| x.get(start + r).copied().unwrap_or(0.0));
+            let x_splat = x_row.map(|v| simd.splat_f64s(v));
+            let mut sums = [simd.splat_f64s(0.0); PANEL_ROWS];
+            let (x_blocks, x_tail) = S::as_simd_f64s(&x[start..]);
+            let (y_blocks, y_tail) = S::as_mut_simd_f64s(&mut y[start..]);
+            let blocks = x_blocks.len();
+            let row_blocks = rows.map(|row| S::as_simd_f64s(row));
+            for k in 0..blocks {
+                let xk = x_blocks[k];
+                let mut yk = y_blocks[k];
+                for r in 0..PANEL_ROWS {
+                    let a = row_blocks[r].0[k];
+                    sums[r] = simd.mul_add_e_f64s(a, xk, sums[r]);
+                    yk = simd.mul_add_e_f64s(a, x_splat[r], yk);
+                }
+                y_blocks[k] = yk;
+            }
+            let mut tail_sums = [0.0; PANEL_ROWS];
+            for (t, (&xj, yj)) in x_tail.iter().zip(y_tail.iter_mut()).enumerate() {
+                for r in 0..PANEL_ROWS {
+                    let a = row_blocks[r].1[t];
+                    tail_sums[r] += a * xj;
+                    *yj += a * x_row[r];
+                }
+            }
+            for r in 0..PANEL_ROWS.min(n - start) {
+                y[start + r] += simd.reduce_sum_f64s(sums[r]) + tail_sums[r];
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,6 +251,37 @@ mod tests {
             }
         }
         SymmetricCsr::from_triplets(n, &t)
+    }
+
+    #[test]
+    fn the_upper_panels_product_is_the_full_product() {
+        // Every remainder of n by the panel's four rows and the SIMD width, and an update of the
+        // values: equal to faer's product with the whole matrix to round-off (n terms ≤ 1).
+        for n in 1..=19 {
+            let a = DenseSymmetric::from_csr(&sample(n));
+            let x: Vec<f64> = (0..n).map(|i| (0.7 * i as f64).cos()).collect();
+            let mut expected = vec![0.0; n];
+            matmul(
+                MatMut::from_column_major_slice_mut(&mut expected, n, 1),
+                Accum::Replace,
+                a.matrix.as_ref(),
+                MatRef::from_column_major_slice(&x, n, 1),
+                1.0,
+                Par::Seq,
+            );
+            let mut y = vec![f64::NAN; n];
+            a.mul_vec(&x, &mut y);
+            for (p, q) in expected.iter().zip(&y) {
+                assert!((p - q).abs() < 1e-14, "n = {n}: {p} {q}");
+            }
+            let mut b = a.clone();
+            let twice = Mat::<f64>::from_fn(n, n, |i, j| 2.0 * a.matrix[(i, j)]);
+            b.assign_symmetrised(twice.as_ref());
+            b.mul_vec(&x, &mut y);
+            for (p, q) in expected.iter().zip(&y) {
+                assert!((2.0 * p - q).abs() < 2e-14, "n = {n}: {p} {q}");
+            }
+        }
     }
 
     #[test]
