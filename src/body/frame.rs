@@ -132,6 +132,63 @@ pub fn polar_rotation(a: &Matrix3<f64>) -> Option<Matrix3<f64>> {
     None
 }
 
+/// The polar factor `R` of `a = R P` by Newton's iteration on the rotation itself, from a
+/// `guess` near it (docs/formulation.md, "The co-moving frame"): with `B = Rᵀ a = S + [w]×`
+/// (`S` symmetric, `[w]×` its skew part), the turn `θ` that makes `(R exp[θ]×)ᵀ a` symmetric
+/// solves, to first order, `(tr S · 1 − S) θ = 2 w` (as `[θ]× S + S [θ]× = [(tr S · 1 − S) θ]×`),
+/// and `R ← R cay(θ)` with the Cayley rotation `cay(θ) = 1 + 2 ([φ]× + [φ]×²) / (1 + |φ|²)`,
+/// `φ = θ/2`, orthogonal to round-off and equal to `exp[θ]×` to second order. Quadratic like
+/// [`polar_rotation`]'s, but each step is a product and a 3 × 3 solve, and from a guess off by
+/// a small strain it takes two or three: it is the best-fit frame's hot path. Once a turn is
+/// below 1e-8 rad, the next would be below round-off: it is the last. `None` if it does not
+/// settle in ten steps or ends at a stationary point other than the maximum of `tr(Rᵀ a)` (a
+/// guess too far); the caller then takes [`nearest_rotation`]. `a` may be singular (a planar
+/// node set: `tr S · 1 − S` stays invertible) or a reflection: the result is
+/// [`nearest_rotation`]'s.
+pub fn polar_rotation_near(a: &Matrix3<f64>, guess: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let mut r = *guess;
+    for _ in 0..10 {
+        let b = r.transpose() * a;
+        let s = 0.5 * (b + b.transpose());
+        // 2 w: twice the axial vector of the skew part (b − bᵀ)/2.
+        let two_w = Vector3::new(
+            b[(2, 1)] - b[(1, 2)],
+            b[(0, 2)] - b[(2, 0)],
+            b[(1, 0)] - b[(0, 1)],
+        );
+        let theta = (Matrix3::identity() * s.trace() - s).try_inverse()? * two_w;
+        let phi = 0.5 * theta;
+        let k = skew(&phi);
+        r *= Matrix3::identity() + (2.0 / (1.0 + phi.norm_squared())) * (k + k * k);
+        if !theta.iter().all(|t| t.is_finite()) {
+            return None;
+        }
+        if theta.norm() <= 1e-8 {
+            // The stationary points of tr(Rᵀ a) over the rotations are `R = U diag(s) Vᵀ`
+            // (a = U Σ Vᵀ, s = ±1, det R = 1), where `tr S · 1 − S` has the eigenvalues
+            // `s_j σ_j + s_k σ_k`: only the maximum, the nearest rotation, has them all
+            // positive (for `det a < 0` too, while σ₃ < σ₂).
+            let b = r.transpose() * a;
+            let s = 0.5 * (b + b.transpose());
+            let h = Matrix3::identity() * s.trace() - s;
+            let minor = h[(0, 0)] * h[(1, 1)] - h[(0, 1)] * h[(1, 0)];
+            return (h[(0, 0)] > 0.0 && minor > 0.0 && h.determinant() > 0.0).then_some(r);
+        }
+    }
+    None
+}
+
+/// The rotation of the columns of `m` orthonormalised in order (Gram–Schmidt: the first
+/// column's direction, the second's part normal to it, their cross product). `None` where the
+/// first two columns are (nearly) parallel.
+fn orthonormalised(m: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+    let e1 = m.column(0).try_normalize(1e-12)?;
+    let c2 = m.column(1);
+    let e2 = (c2 - e1 * e1.dot(&c2)).try_normalize(1e-12 * c2.norm())?;
+    let e3 = e1.cross(&e2);
+    Some(Matrix3::from_columns(&[e1, e2, e3]))
+}
+
 /// Weights and reference geometry of a best-fit frame over a set of nodes: positive weights
 /// `w_i` (kg, HRZ-lumped masses for the body frame), the weighted reference centroid `X_c` and
 /// the reference offsets `X̄_i = X_i − X_c`.
@@ -153,6 +210,65 @@ pub struct FrameWeights {
     pub arms: Vec<Vector3<f64>>,
     /// `e_k`, the coefficients of the constant field; `None`: 1 for every node.
     pub unit: Option<Vec<f64>>,
+    /// [`Self::best_fit`]'s first guess of `R` from `A`; `None` for a collinear node set.
+    guess: Option<RotationGuess>,
+}
+
+/// The first guess of a best-fit frame's rotation from its moment `A`
+/// ([`FrameWeights::best_fit`]). At the reference `A_ref = Σ_k X̄_k a_kᵀ = Σ w_i X̄_i X̄_iᵀ`
+/// (symmetric, positive semi-definite), and a body turned by `R` and strained has
+/// `A ≈ R A_ref`, so `A A_ref⁺` is `R` up to the strain on the range of `A_ref`. A planar node
+/// set has `A_ref n = 0` for its normal `n`; there `R n = R t₁ × R t₂` (`t₁, t₂` spanning the
+/// plane) completes it. The guess is that matrix orthonormalised.
+#[derive(Debug, Clone, Copy)]
+struct RotationGuess {
+    /// `A_ref⁺`, the pseudo-inverse (the inverse unless the set is planar).
+    pseudo_inverse: Matrix3<f64>,
+    /// `(t₁, t₂, n)` of a planar set.
+    plane: Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>)>,
+}
+
+impl RotationGuess {
+    /// From the reference offsets and arms; `None` where two or three of `A_ref`'s eigenvalues
+    /// are below 1e-12 of the largest (a collinear set, a point).
+    fn new(offsets: &[Vector3<f64>], arms: &[Vector3<f64>]) -> Option<RotationGuess> {
+        let mut moment = Matrix3::zeros();
+        for (offset, arm) in offsets.iter().zip(arms) {
+            add_outer(&mut moment, offset, arm);
+        }
+        let eigen = (0.5 * (moment + moment.transpose())).symmetric_eigen();
+        let largest = eigen.eigenvalues.amax();
+        let null: Vec<usize> = (0..3)
+            .filter(|&k| eigen.eigenvalues[k] <= 1e-12 * largest)
+            .collect();
+        if !(largest.is_finite() && largest > 0.0) || null.len() > 1 {
+            return None;
+        }
+        let mut pseudo_inverse = Matrix3::zeros();
+        for k in (0..3).filter(|k| !null.contains(k)) {
+            let e = eigen.eigenvectors.column(k).into_owned();
+            pseudo_inverse += e * e.transpose() / eigen.eigenvalues[k];
+        }
+        let plane = null.first().map(|&k| {
+            let column = |j: usize| eigen.eigenvectors.column(j).into_owned();
+            let (t1, t2) = (column((k + 1) % 3), column((k + 2) % 3));
+            (t1, t2, t1.cross(&t2))
+        });
+        Some(RotationGuess {
+            pseudo_inverse,
+            plane,
+        })
+    }
+
+    /// The guessed rotation for the moment `a`; `None` if it degenerates.
+    fn rotation(&self, a: &Matrix3<f64>) -> Option<Matrix3<f64>> {
+        let mut m = a * self.pseudo_inverse;
+        if let Some((t1, t2, n)) = &self.plane {
+            let normal = (m * t1).cross(&(m * t2));
+            add_outer(&mut m, &normal, n);
+        }
+        orthonormalised(&m)
+    }
 }
 
 /// A frame: origin `c` (m) and rotation `R` (columns: frame axes in global coordinates).
@@ -185,12 +301,13 @@ impl FrameWeights {
             .iter()
             .zip(&reference_offsets)
             .map(|(&w, xbar)| w * xbar)
-            .collect();
+            .collect::<Vec<_>>();
         FrameWeights {
             nodes,
             weights,
             total_weight,
             reference_centroid: centroid,
+            guess: RotationGuess::new(&reference_offsets, &arms),
             reference_offsets,
             arms,
             unit: None,
@@ -213,6 +330,7 @@ impl FrameWeights {
             weights,
             total_weight,
             reference_centroid,
+            guess: RotationGuess::new(&reference_offsets, &arms),
             reference_offsets,
             arms,
             unit: Some(unit),
@@ -236,17 +354,20 @@ impl FrameWeights {
     }
 
     /// The best-fit frame of positions `x`: `c` and `R = polar(Σ w_i (x_i − c) X̄_iᵀ)`
-    /// (`= polar(Σ_k (q_k − c e_k) a_kᵀ)`).
+    /// (`= polar(Σ_k (q_k − c e_k) a_kᵀ)`), by [`polar_rotation_near`] from the guess
+    /// `A A_ref⁺` orthonormalised ([`RotationGuess`]), else by [`nearest_rotation`].
     pub fn best_fit(&self, x: &[f64]) -> Frame {
         let origin = self.centroid(x);
         let mut a = Matrix3::zeros();
         for (k, (&n, arm)) in self.nodes.iter().zip(&self.arms).enumerate() {
             add_outer(&mut a, &(node(x, n) - self.unit(k) * origin), arm);
         }
-        Frame {
-            origin,
-            rotation: nearest_rotation(&a),
-        }
+        let rotation = self
+            .guess
+            .and_then(|guess| guess.rotation(&a))
+            .and_then(|guess| polar_rotation_near(&a, &guess))
+            .unwrap_or_else(|| nearest_rotation(&a));
+        Frame { origin, rotation }
     }
 
     /// `H = Σ w_i [X̄_i]× [X̄_i + ū_i]×` for the frame `frame` of positions `x` (≈ minus the
@@ -484,6 +605,92 @@ mod tests {
         assert!((rotation * Vector3::x() - r * Vector3::x()).norm() < 1e-12);
         let reflection = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
         assert!(polar_rotation(&reflection).is_none());
+    }
+
+    #[test]
+    fn newton_on_the_rotation_is_the_polar_factor() {
+        // a = R P as above, P off the reference moment J by a strain ε: from the guess
+        // `a J⁻¹` orthonormalised the iteration on the rotation returns the polar factor to
+        // κ × round-off, as the scaled Newton iteration does.
+        let r = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.3, -1.1, 0.7)).into_inner();
+        let q = nalgebra::Rotation3::from_scaled_axis(Vector3::new(-0.9, 0.2, 0.4)).into_inner();
+        for kappa in [1.0, 1e2, 1e4, 1e6] {
+            let j = q * Matrix3::from_diagonal(&Vector3::new(kappa, 3.0, 1.0)) * q.transpose();
+            for strain in [0.0, 1e-3, 0.1, 0.3] {
+                let e = strain * Matrix3::new(0.3, -0.5, 0.2, 0.1, 0.4, -0.6, 0.7, 0.2, -0.1);
+                let a = r * (Matrix3::identity() + e) * j;
+                let guess = orthonormalised(&(a * j.try_inverse().unwrap())).unwrap();
+                let near = polar_rotation_near(&a, &guess).expect("converges");
+                let newton = polar_rotation(&a).expect("well conditioned");
+                assert!((near.transpose() * near - Matrix3::identity()).norm() < 1e-14);
+                assert!((near.determinant() - 1.0).abs() < 1e-14);
+                assert!(
+                    (near - newton).norm() < 1e-14 * kappa.max(10.0),
+                    "κ = {kappa:e}, ε = {strain}: {:e}",
+                    (near - newton).norm()
+                );
+            }
+        }
+        // A guess half a turn away finds a stationary point that is not the polar factor, or
+        // none: never a wrong rotation.
+        let a = r * Matrix3::from_diagonal(&Vector3::new(3.0, 2.0, 1.0));
+        let flipped = r * Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0));
+        assert!(polar_rotation_near(&a, &flipped).is_none());
+        // A planar moment (rank 2) and a reflection: the SVD's nearest rotation.
+        for d in [
+            Vector3::new(3.0, 2.0, 0.0),
+            Vector3::new(3.0, 2.0, -1.0),
+            Vector3::new(3.0, 2.0, -1e-3),
+        ] {
+            let a = r * Matrix3::from_diagonal(&d) * q;
+            let svd = nearest_rotation(&a);
+            let near = polar_rotation_near(&a, &(svd * q.transpose() * q)).expect("converges");
+            assert!((near - svd).norm() < 1e-14, "{d:?}");
+            let guess = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.1, -0.2, 0.15));
+            let near = polar_rotation_near(&a, &(svd * guess.into_inner())).expect("converges");
+            assert!(
+                (near - svd).norm() < 1e-14,
+                "{d:?}: {:e}",
+                (near - svd).norm()
+            );
+        }
+    }
+
+    #[test]
+    fn the_frame_of_a_planar_node_set_is_its_turn() {
+        // Four nodes of a skew square (a face, an interface), turned and stretched in plane:
+        // the guess completes the normal, and the frame is the SVD's nearest rotation.
+        let turn = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.4, 1.3, -0.8));
+        let tilt = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.3, 0.2, 0.1));
+        let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 2.0), (0.0, 2.0)];
+        let reference: Vec<f64> = corners
+            .iter()
+            .flat_map(|&(u, v)| {
+                let p = tilt * Vector3::new(u, v, 0.0);
+                [p.x, p.y, p.z]
+            })
+            .collect();
+        let fw = FrameWeights::new(vec![0, 1, 2, 3], vec![1.0, 2.0, 1.0, 3.0], &reference);
+        assert!(fw.guess.is_some_and(|g| g.plane.is_some()));
+        let stretch =
+            tilt * Matrix3::new(1.05, 0.02, 0.0, -0.01, 0.97, 0.0, 0.0, 0.0, 1.0) * tilt.inverse();
+        let x: Vec<f64> = (0..4)
+            .flat_map(|i| {
+                let p = turn * (stretch * node(&reference, i)) + Vector3::new(1.0, -2.0, 0.5);
+                [p.x, p.y, p.z]
+            })
+            .collect();
+        let frame = fw.best_fit(&x);
+        let mut a = Matrix3::zeros();
+        for (k, arm) in fw.arms.iter().enumerate() {
+            add_outer(&mut a, &(node(&x, k) - frame.origin), arm);
+        }
+        assert!((frame.rotation - nearest_rotation(&a)).norm() < 1e-14);
+        assert!((frame.rotation - turn.into_inner()).norm() < 0.05);
+        // … by the iteration from the guess, not the SVD's fallback.
+        let guess = fw.guess.and_then(|g| g.rotation(&a)).expect("a guess");
+        let near = polar_rotation_near(&a, &guess).expect("converges");
+        assert_eq!(near, frame.rotation);
     }
 
     #[test]
