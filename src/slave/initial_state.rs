@@ -154,7 +154,7 @@ impl Slave {
                 ),
             });
         }
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         Ok(())
     }
 

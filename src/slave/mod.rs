@@ -17,7 +17,7 @@ use crate::solver::problem::{DynamicState, FreeNodes};
 use assembly::Model;
 use interfaces::{default_inputs, interfaces_of, Interface};
 use nalgebra::Vector3;
-use outputs::Outputs;
+use outputs::{OutputGroup, Outputs};
 use results::file_stem;
 use std::path::Path;
 use step_control::Ladder;
@@ -296,10 +296,7 @@ impl Slave {
             dynamics: None,
             backup: None,
             retry_backup: None,
-            outputs: Outputs {
-                interfaces: vec![[0.0; INTERFACE_SLOTS]; n_interfaces],
-                ..Outputs::default()
-            },
+            outputs: Outputs::new(n_interfaces),
             statistics: (0, 0),
             retries: 0,
             rejected: 0,
@@ -383,7 +380,7 @@ impl Slave {
         self.last_step_size = 0.0;
         self.jacobian_step = None;
         self.input_times.fill(self.start_time);
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         Ok(())
     }
 
@@ -524,7 +521,7 @@ impl Slave {
         self.beyond_finest = (0, false);
         self.floor_warned = false;
         self.tolerance_followed = false;
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         self.results = None;
     }
 
@@ -607,7 +604,7 @@ impl Slave {
             model.apply_features(d.features);
             model.refresh_slab_stiffening(&d.state.position);
         }
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         Ok(())
     }
 

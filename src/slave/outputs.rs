@@ -12,10 +12,18 @@ use crate::model::{InterfaceKind, Target, VariableType};
 use crate::solver::problem::{last_residual, residual, DynamicState, FreeNodes};
 use nalgebra::{Matrix3, Vector3};
 
-/// Outputs computed once per state, on the first read.
+/// Outputs computed once per state, on the first read, in groups: an importer that reads one
+/// interface's motion pays for that alone, not for the residual that the reactions and the
+/// body's strain energy need (docs/fmu.md, "Outputs").
 #[derive(Debug, Clone, Default)]
 pub(super) struct Outputs {
-    pub(super) valid: bool,
+    /// Whether `body` and `body_acceleration` are those of the current state.
+    body_valid: bool,
+    /// Per interface: whether its slots are those of the current state.
+    interface_valid: Vec<bool>,
+    /// The residual's kinematics when the residual's scratch holds the current state's
+    /// residual.
+    residual: Option<BodyKinematics>,
     pub(super) body: [f64; 26],
     /// Acceleration of the centre of mass (for output derivatives).
     pub(super) body_acceleration: [f64; 3],
@@ -26,10 +34,58 @@ pub(super) struct Outputs {
     pub(super) momentum: Vec<f64>,
 }
 
+impl Outputs {
+    /// No outputs for `interfaces` interfaces yet.
+    pub(super) fn new(interfaces: usize) -> Outputs {
+        Outputs {
+            interface_valid: vec![false; interfaces],
+            interfaces: vec![[0.0; super::INTERFACE_SLOTS]; interfaces],
+            ..Outputs::default()
+        }
+    }
+
+    /// The state changed: every group is computed again on its next read.
+    pub(super) fn invalidate(&mut self) {
+        self.body_valid = false;
+        self.residual = None;
+        self.interface_valid.fill(false);
+    }
+}
+
+/// Which outputs [`Slave::ensure_outputs`] computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum OutputGroup {
+    /// The `body.*` outputs.
+    Body,
+    /// Interface `k`'s outputs.
+    Interface(usize),
+    /// All of them (and the residual's scratch of the current state).
+    All,
+}
+
 impl Slave {
-    /// Computes the outputs of the current state (once per state).
-    pub(super) fn ensure_outputs(&mut self) -> Result<()> {
-        if self.outputs.valid {
+    /// Computes the outputs of `group` for the current state (once per state). The residual
+    /// (`M ẍ + f − f_ext`) is evaluated only where something reads it: the body's outputs (its
+    /// frame and strain energy) and the reactions of fixed supports and motion interfaces, which
+    /// are all taken from it at once, so that no group reads a residual's scratch that another
+    /// computation may have overwritten since.
+    pub(super) fn ensure_outputs(&mut self, group: OutputGroup) -> Result<()> {
+        let all = group == OutputGroup::All;
+        let wanted = |k: usize| all || group == OutputGroup::Interface(k);
+        let body_wanted = all || group == OutputGroup::Body;
+        let reaction =
+            |kind: InterfaceKind| matches!(kind, InterfaceKind::Fixed | InterfaceKind::Motion);
+        let outputs = &self.outputs;
+        let stale = |k: usize| wanted(k) && !outputs.interface_valid[k];
+        let interfaces = 0..self.interfaces.len();
+        let body_stale = body_wanted && !outputs.body_valid;
+        let needs_residual = outputs.residual.is_none()
+            && (all
+                || body_stale
+                || interfaces
+                    .clone()
+                    .any(|k| stale(k) && reaction(self.interfaces[k].kind)));
+        if !(needs_residual || body_stale || interfaces.clone().any(stale)) {
             return Ok(());
         }
         if self.dynamics.is_none() {
@@ -43,39 +99,59 @@ impl Slave {
         let dynamics = self.dynamics.as_ref().unwrap();
         let state = &dynamics.state;
         let body = &model.body;
-        let gravity = Vector3::from(dynamics.gravity);
-        let interfaces = &self.interfaces;
-        let loads_in = &dynamics.loads;
-        let loads = |x: &[f64], f: &mut [f64]| {
-            apply_loads(body, interfaces, loads_in, None, &gravity, x, f)
-        };
-        let kin = residual(body, &model.free, state, &loads, &mut model.forces);
-        let residual = last_residual(&model.forces);
-        body_outputs(body, state, &kin, &mut self.outputs);
-        for (k, interface) in self.interfaces.iter().enumerate() {
+        let outputs = &mut self.outputs;
+        let names = &self.body_file.interfaces;
+        let interface = |k: usize, residual: &[f64], outputs: &mut Outputs| {
             interface_outputs(
-                interface,
+                &self.interfaces[k],
                 &model.free,
                 state,
                 residual,
                 &dynamics.loads[k],
-                &mut self.outputs.interfaces[k],
+                &mut outputs.interfaces[k],
             );
+            if !outputs.interfaces[k].iter().all(|x| x.is_finite()) {
+                return Err(Error::new(format!(
+                    "the outputs of interface '{}' in the current state are not finite",
+                    names[k].name
+                )));
+            }
+            outputs.interface_valid[k] = true;
+            Ok(())
+        };
+        if needs_residual {
+            let gravity = Vector3::from(dynamics.gravity);
+            let loads_in = &dynamics.loads;
+            let loads = |x: &[f64], f: &mut [f64]| {
+                apply_loads(body, &self.interfaces, loads_in, None, &gravity, x, f)
+            };
+            let kin = residual(body, &model.free, state, &loads, &mut model.forces);
+            outputs.residual = Some(kin);
+            let residual = last_residual(&model.forces);
+            for k in interfaces.clone() {
+                if reaction(self.interfaces[k].kind) {
+                    interface(k, residual, outputs)?;
+                }
+            }
         }
-        let finite = self.outputs.body.iter().all(|x| x.is_finite())
-            && self.outputs.body_acceleration.iter().all(|x| x.is_finite())
-            && self
-                .outputs
-                .interfaces
-                .iter()
-                .flatten()
-                .all(|x| x.is_finite());
-        if !finite {
-            return Err(Error::new(
-                "the outputs of the current state are not finite",
-            ));
+        if body_stale {
+            let kin = outputs.residual.expect("evaluated above");
+            body_outputs(body, state, &kin, outputs);
+            let finite = outputs.body.iter().all(|x| x.is_finite())
+                && outputs.body_acceleration.iter().all(|x| x.is_finite());
+            if !finite {
+                return Err(Error::new(
+                    "the body's outputs of the current state are not finite",
+                ));
+            }
+            outputs.body_valid = true;
         }
-        self.outputs.valid = true;
+        for k in interfaces {
+            if wanted(k) && !outputs.interface_valid[k] {
+                // Not a reaction: the residual is not read.
+                interface(k, &[], outputs)?;
+            }
+        }
         Ok(())
     }
 
@@ -121,7 +197,11 @@ impl Slave {
                 &format!("must be 1 or {MAX_OUTPUT_DERIVATIVE_ORDER} (maxOutputDerivativeOrder)"),
             ));
         }
-        self.ensure_outputs()?;
+        let group = match target {
+            Target::Interface { index, .. } => OutputGroup::Interface(index),
+            _ => OutputGroup::Body,
+        };
+        self.ensure_outputs(group)?;
         let value = match target {
             Target::Interface {
                 index,

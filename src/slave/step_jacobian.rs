@@ -3,7 +3,7 @@
 //! held over it, for masters that couple implicitly.
 
 use super::interfaces::apply_loads;
-use super::{Inputs, Slave};
+use super::{Inputs, OutputGroup, Slave};
 use crate::body::frame::left_jacobian;
 use crate::body::frame::set_node;
 use crate::body::interface::{DrivingFrame, NodeSet};
@@ -190,8 +190,8 @@ impl Slave {
             Ok(())
         });
         // The outputs (and the residual's scratch) of the state as it is, whatever happened.
-        self.outputs.valid = false;
-        let outputs = self.ensure_outputs();
+        self.outputs.invalidate();
+        let outputs = self.ensure_outputs(OutputGroup::All);
         result.and(outputs)
     }
 
@@ -588,7 +588,7 @@ impl Slave {
             if let Some((k, slot)) = load_seed {
                 dynamics.loads[k][slot] = ws.saved_loads[k][slot] + sign * epsilon;
             }
-            self.outputs.valid = false;
+            self.outputs.invalidate();
             for (i, &vr) in outputs.iter().enumerate() {
                 match self.get_real(vr) {
                     Ok(y) if sign > 0.0 => jacobian[i * columns + j] = y,
@@ -605,7 +605,7 @@ impl Slave {
         let dynamics = self.dynamics.as_mut().unwrap();
         dynamics.state.copy_from(&ws.saved);
         dynamics.loads.clone_from(&ws.saved_loads);
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         result
     }
 }

@@ -578,7 +578,7 @@ impl Slave {
                 dynamics,
             );
         }
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         self.watch_strain(t0 + big_h);
         if self.results.is_some() {
             self.write_results();
@@ -608,7 +608,7 @@ impl Slave {
             model.apply_features(before.features);
         }
         self.driving.copy_from_slice(&self.driving_before);
-        self.outputs.valid = false;
+        self.outputs.invalidate();
         // The failed step's decisions are undone, and so are their messages (a switch logged
         // and rolled back would tell the importer of a model the next step does not use).
         let mut index = 0;

@@ -1,7 +1,7 @@
 //! Variable access by value reference: typed get and set, start values, input derivatives.
 
 use super::parameters::{Parameters, Slot};
-use super::{Slave, MAX_INPUT_DERIVATIVE_ORDER};
+use super::{OutputGroup, Slave, MAX_INPUT_DERIVATIVE_ORDER};
 use crate::error::{Error, Result};
 use crate::model::model_description::format_real;
 use crate::model::variables::{EnumerationSpec, FixedKey, InterfaceQuantity};
@@ -133,7 +133,7 @@ impl Slave {
             Target::Fixed { key, component } => match self.parameters.real(key, component) {
                 Some(p) => p,
                 None => {
-                    self.ensure_outputs()?;
+                    self.ensure_outputs(OutputGroup::Body)?;
                     self.outputs.body[body_output_slot(key) + component]
                 }
             },
@@ -145,7 +145,7 @@ impl Slave {
                 if causality == crate::model::Causality::Input {
                     self.inputs[index][quantity.slot() as usize + component]
                 } else {
-                    self.ensure_outputs()?;
+                    self.ensure_outputs(OutputGroup::Interface(index))?;
                     self.outputs.interfaces[index][quantity.slot() as usize + component]
                 }
             }
