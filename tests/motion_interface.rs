@@ -164,5 +164,8 @@ fn outputs_read_in_any_order_are_the_same_numbers() {
     }
     // The runs read different outputs: their states are still the same.
     let tip: Vec<f64> = runs.iter_mut().map(|r| get(r, "tip.position[2]")).collect();
-    assert!(tip.iter().all(|&y| y.to_bits() == tip[0].to_bits()), "{tip:?}");
+    assert!(
+        tip.iter().all(|&y| y.to_bits() == tip[0].to_bits()),
+        "{tip:?}"
+    );
 }

@@ -41,8 +41,16 @@ pub fn remaining_error(correction: f64, previous_correction: f64) -> f64 {
 /// `max(largest, ‖dx‖_∞)`, or infinity if an entry of `dx` is not finite: a non-finite
 /// correction never counts as converged (`f64::max` would drop a NaN).
 pub fn largest_correction(largest: f64, dx: &[f64]) -> f64 {
-    if dx.iter().all(|v| v.is_finite()) {
-        dx.iter().fold(largest, |m, v| m.max(v.abs()))
+    // One pass: the largest magnitude, and whether any entry is not finite (`|v| ≤ ∞` fails
+    // for a NaN only; an infinity is caught by the comparison with `f64::MAX`).
+    let (mut m, mut finite) = (largest, true);
+    for v in dx {
+        let a = v.abs();
+        finite &= a <= f64::MAX;
+        m = if a > m { a } else { m };
+    }
+    if finite {
+        m
     } else {
         f64::INFINITY
     }

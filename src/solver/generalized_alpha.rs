@@ -536,13 +536,12 @@ impl IterationMatrix {
                 lambda,
             );
         }
-        let mut largest: f64 = 0.0;
         for (k, &i) in free.nodes.iter().enumerate() {
             let dx = -(rotation(i) * node(&ws.reduced, k));
             set_node(&mut ws.update, k, &dx);
-            largest = largest_correction(largest, dx.as_slice());
         }
         let nf3 = free.dof_count();
+        let largest = largest_correction(0.0, &ws.update[..nf3]);
         for (u, (&new, &old)) in ws.update[nf3..]
             .iter_mut()
             .zip(state.multipliers.iter().zip(&ws.iterate[nf3..]))
