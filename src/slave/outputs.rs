@@ -126,13 +126,14 @@ impl Slave {
                 apply_loads(body, &self.interfaces, loads_in, None, &gravity, x, f)
             };
             let kin = residual(body, &model.free, state, &loads, &mut model.forces);
-            outputs.residual = Some(kin);
             let residual = last_residual(&model.forces);
             for k in interfaces.clone() {
                 if reaction(self.interfaces[k].kind) {
                     interface(k, residual, outputs)?;
                 }
             }
+            // Only once every reaction is taken: after an error the next read evaluates again.
+            outputs.residual = Some(kin);
         }
         if body_stale {
             let kin = outputs.residual.expect("evaluated above");
@@ -148,7 +149,8 @@ impl Slave {
         }
         for k in interfaces {
             if wanted(k) && !outputs.interface_valid[k] {
-                // Not a reaction: the residual is not read.
+                // Not a reaction (the reactions are valid with the residual): it is not read.
+                debug_assert!(!reaction(self.interfaces[k].kind));
                 interface(k, &[], outputs)?;
             }
         }
