@@ -193,6 +193,10 @@ pub struct Slave {
     /// Whether the body has said that the iteration's tolerance follows the allowance of the
     /// internal steps (`slave::stepping::internal_steps`).
     tolerance_followed: bool,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`: the outputs read
+    /// there are those of the rigidly placed body with the inputs and parameters as they are,
+    /// so setting one drops the placement computed for an earlier read.
+    initializing: bool,
     /// The error control's scratch over the communication step under way: the largest ratio of
     /// an internal step's error estimate to its allowance (`None`: no step was estimated).
     step_error: Option<f64>,
@@ -304,6 +308,7 @@ impl Slave {
             beyond_finest: (0, false),
             floor_warned: false,
             tolerance_followed: false,
+            initializing: false,
             step_error: None,
             step_error_unfloored: 0.0,
             step_estimate: 0.0,
@@ -376,6 +381,7 @@ impl Slave {
 
     /// `fmi2EnterInitializationMode`.
     pub fn enter_initialization_mode(&mut self) -> Result<()> {
+        self.initializing = true;
         self.dynamics = None;
         self.last_step_size = 0.0;
         self.jacobian_step = None;
@@ -390,6 +396,7 @@ impl Slave {
         self.ensure_initial_state()?;
         let h = self.parameters.step_size;
         self.prepare_step_size(h)?;
+        self.initializing = false;
         self.results = None;
         if !self.parameters.output_directory.is_empty() {
             match ResultWriter::create(
@@ -555,6 +562,9 @@ impl Slave {
         {
             return Err(Error::new("the FMU state belongs to another body"));
         }
+        // What follows changes the parameters and inputs, then may fail: no output computed
+        // before may be served after it.
+        self.outputs.invalidate();
         self.parameters = state.parameters.clone();
         self.inputs.clone_from(&state.inputs);
         self.input_derivatives.clone_from(&state.input_derivatives);

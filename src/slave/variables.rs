@@ -29,6 +29,16 @@ pub(super) fn body_output_slot(key: FixedKey) -> usize {
 }
 
 impl Slave {
+    /// Before any variable is set: in initialization mode the rigid placement computed for an
+    /// output read before is no longer that of the inputs and parameters, and is dropped (the
+    /// next read places the body again).
+    fn setting_a_variable(&mut self) {
+        if self.initializing {
+            self.dynamics = None;
+            self.outputs.invalidate();
+        }
+    }
+
     /// Sets a Real, Integer or Boolean variable by name (for scripts and measurements: an
     /// Integer takes `value` when it is integral, a Boolean `value != 0`); the same checks as
     /// the typed setters.
@@ -77,6 +87,7 @@ impl Slave {
     /// Sets a String parameter (`output.directory`: any text; a directory that cannot be created
     /// is reported when the results are first written).
     pub fn set_string(&mut self, vr: u32, value: &str) -> Result<()> {
+        self.setting_a_variable();
         let v = self.lookup(VariableType::String, vr)?;
         match self.parameters.target_mut(v.target) {
             Some(Slot::Text(text)) => {
@@ -164,6 +175,7 @@ impl Slave {
     /// message naming the variable; a rejected value changes nothing. Allocation-free unless it
     /// fails.
     pub fn set_real(&mut self, vr: u32, value: f64) -> Result<()> {
+        self.setting_a_variable();
         let v = self
             .variables
             .get(VariableType::Real, vr)
@@ -213,6 +225,7 @@ impl Slave {
 
     /// Sets an Integer parameter after [`Slave::check_integer`].
     pub fn set_integer(&mut self, vr: u32, value: i32) -> Result<()> {
+        self.setting_a_variable();
         let v = self.lookup(VariableType::Integer, vr)?;
         self.check_integer(&v, value)?;
         match self.parameters.target_mut(v.target) {
@@ -276,6 +289,7 @@ impl Slave {
     }
 
     pub fn set_boolean(&mut self, vr: u32, value: bool) -> Result<()> {
+        self.setting_a_variable();
         let v = self.lookup(VariableType::Boolean, vr)?;
         match self.parameters.target_mut(v.target) {
             Some(Slot::Boolean(x)) => {
