@@ -8,6 +8,7 @@ pub mod interface;
 pub mod lowest_modes;
 pub mod lumped_body;
 pub mod patches;
+pub mod polar;
 pub mod reduction;
 pub mod slab_stiffening;
 pub mod stiffening;

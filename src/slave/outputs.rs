@@ -1,4 +1,4 @@
-//! Outputs, computed once per state on the first read, and their time derivatives.
+//! Outputs, computed once per state and by group on their first read, and their time derivatives.
 
 use super::interfaces::{apply_loads, Interface};
 use super::variables::body_output_slot;
