@@ -80,12 +80,12 @@ pub fn polar_rotation_near(a: &Matrix3<f64>, guess: &Matrix3<f64>) -> Option<Mat
             b[(1, 0)] - b[(0, 1)],
         );
         let theta = (Matrix3::identity() * s.trace() - s).try_inverse()? * two_w;
-        let phi = 0.5 * theta;
-        let k = skew(&phi);
-        r *= Matrix3::identity() + (2.0 / (1.0 + phi.norm_squared())) * (k + k * k);
         if !theta.iter().all(|t| t.is_finite()) {
             return None;
         }
+        let phi = 0.5 * theta;
+        let k = skew(&phi);
+        r *= Matrix3::identity() + (2.0 / (1.0 + phi.norm_squared())) * (k + k * k);
         if theta.norm() <= 1e-8 {
             // The stationary points of tr(Rᵀ a) over the rotations are `R = U diag(s) Vᵀ`
             // (a = U Σ Vᵀ, s = ±1, det R = 1), where `tr S · 1 − S` has the eigenvalues
@@ -162,13 +162,19 @@ impl RotationGuess {
 mod tests {
     use super::*;
 
+    /// The turn `R` of the tests' moments `a = R P` and the principal axes `Q` of `P`.
+    fn turn_and_axes() -> (Matrix3<f64>, Matrix3<f64>) {
+        let turn = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.3, -1.1, 0.7));
+        let axes = nalgebra::Rotation3::from_scaled_axis(Vector3::new(-0.9, 0.2, 0.4));
+        (turn.into_inner(), axes.into_inner())
+    }
+
     #[test]
     fn newton_polar_factor_recovers_the_rotation() {
         // a = R P with R a rotation and P symmetric positive definite of condition κ: the
         // iteration returns R, orthogonal with det +1 to round-off, within κ × round-off of
         // R and within the SVD's own error of the SVD's.
-        let r = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.3, -1.1, 0.7)).into_inner();
-        let q = nalgebra::Rotation3::from_scaled_axis(Vector3::new(-0.9, 0.2, 0.4)).into_inner();
+        let (r, q) = turn_and_axes();
         for kappa in [1.0, 1e2, 1e4, 1e6] {
             let p = q * Matrix3::from_diagonal(&Vector3::new(kappa, 3.0, 1.0)) * q.transpose();
             let a = r * p;
@@ -203,8 +209,7 @@ mod tests {
         // a = R P as above, P off the reference moment J by a strain ε: from the guess of J's
         // principal axes' images the iteration on the rotation returns the polar factor to
         // κ × round-off, as the scaled Newton iteration does.
-        let r = nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.3, -1.1, 0.7)).into_inner();
-        let q = nalgebra::Rotation3::from_scaled_axis(Vector3::new(-0.9, 0.2, 0.4)).into_inner();
+        let (r, q) = turn_and_axes();
         for kappa in [1.0, 1e2, 1e4, 1e6] {
             let j = q * Matrix3::from_diagonal(&Vector3::new(kappa, 3.0, 1.0)) * q.transpose();
             for strain in [0.0, 1e-3, 0.1, 0.3] {

@@ -19,6 +19,8 @@ pub struct DenseSymmetric {
     matrix: Mat<f64>,
     /// The upper triangle of `matrix`, for [`Self::mul_vec`].
     upper: UpperPanels,
+    /// The SIMD instruction set found at run time (`pulp`, faer's SIMD layer).
+    arch: Arch,
 }
 
 impl DenseSymmetric {
@@ -38,7 +40,11 @@ impl DenseSymmetric {
     pub fn new(matrix: Mat<f64>) -> DenseSymmetric {
         assert_eq!(matrix.nrows(), matrix.ncols(), "DenseSymmetric: not square");
         let upper = UpperPanels::new(matrix.as_ref());
-        DenseSymmetric { matrix, upper }
+        DenseSymmetric {
+            matrix,
+            upper,
+            arch: Arch::new(),
+        }
     }
 
     /// Overwrite the matrix with the symmetric `(m + mᵀ)/2` of a square `m` of the same
@@ -66,7 +72,7 @@ impl DenseSymmetric {
     /// ([`UpperPanels::mul_vec`]): B1's reduced solve with `A⁻¹` (`n` = 129) takes 1.0 µs
     /// against 1.6 µs of faer's product with the whole matrix (a 200 000-fold loop, best of 5).
     pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
-        self.upper.mul_vec(x, y);
+        self.upper.mul_vec(self.arch, x, y);
     }
 
     /// `y = A[:, columns] x` (`x` of the columns' length, `y` of `n`): the contiguous columns
@@ -78,7 +84,7 @@ impl DenseSymmetric {
             x.len() == columns.len() && y.len() == self.dim() && columns.end <= self.dim(),
             "DenseSymmetric::mul_columns: lengths"
         );
-        self.upper.arch.dispatch(ColumnsProduct {
+        self.arch.dispatch(ColumnsProduct {
             matrix: &self.matrix,
             first: columns.start,
             x,
@@ -121,8 +127,6 @@ struct UpperPanels {
     /// The panels one after another; panel `p` starts at `offsets[p]`.
     entries: Vec<f64>,
     offsets: Vec<usize>,
-    /// The SIMD instruction set found at run time (`pulp`, faer's SIMD layer).
-    arch: Arch,
 }
 
 /// Rows per panel of [`UpperPanels`]: four accumulators and four broadcast values stay in
@@ -143,7 +147,6 @@ impl UpperPanels {
             n,
             entries: vec![0.0; length],
             offsets,
-            arch: Arch::new(),
         };
         upper.assign(a);
         upper
@@ -172,13 +175,14 @@ impl UpperPanels {
         }
     }
 
-    /// `y = A x`, each stored entry read once. No allocation.
-    fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+    /// `y = A x`, each stored entry read once, with the SIMD instructions of `arch`. No
+    /// allocation.
+    fn mul_vec(&self, arch: Arch, x: &[f64], y: &mut [f64]) {
         assert!(
             x.len() == self.n && y.len() == self.n,
             "UpperPanels: length"
         );
-        self.arch.dispatch(PanelProduct { upper: self, x, y });
+        arch.dispatch(PanelProduct { upper: self, x, y });
     }
 }
 

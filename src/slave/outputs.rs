@@ -14,7 +14,7 @@ use nalgebra::{Matrix3, Vector3};
 
 /// Outputs computed once per state, on the first read, in groups: an importer that reads one
 /// interface's motion pays for that alone, not for the residual that the reactions and the
-/// body's strain energy need (docs/fmu.md, "Outputs").
+/// body's strain energy need (docs/fmu.md, "Variables").
 #[derive(Debug, Clone, Default)]
 pub(super) struct Outputs {
     /// Whether `body` and `body_acceleration` are those of the current state.
