@@ -137,6 +137,7 @@ impl Slave {
             deformation_scale: 0.0,
             high_mode_scale: 0.0,
             estimate_floor: 0.0,
+            slab_stiffening_ratio: 0.0,
         });
         if let Some(horizon) = self.error_horizon() {
             let over = match self.run_length() {

@@ -87,6 +87,9 @@ struct Dynamics {
     /// The estimate that refining did not reduce (m): the iteration's or the model's own noise
     /// in the estimate, below which the error control does not refine ([`step_control`]).
     estimate_floor: f64,
+    /// The slabs' stiffening ratio last measured while it was off (`choose_slab_stiffening`):
+    /// near the switch it is measured at every communication step, otherwise once per `T₁/16`.
+    slab_stiffening_ratio: f64,
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,

@@ -245,6 +245,7 @@ impl SlaveState {
                 w.f64(d.deformation_scale);
                 w.f64(d.high_mode_scale);
                 w.f64(d.estimate_floor);
+                w.f64(d.slab_stiffening_ratio);
                 w.f64(s.step_size);
             }
         }
@@ -474,6 +475,7 @@ impl Slave {
                 let deformation_scale = r.f64("the deformation scale")?;
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
                 let estimate_floor = r.f64("the estimate floor")?;
+                let slab_stiffening_ratio = r.f64("the slabs' stiffening ratio")?;
                 for (scale, name) in [
                     (estimate_floor, "estimate floor"),
                     (deformation_scale, "deformation scale"),
@@ -517,6 +519,7 @@ impl Slave {
                     deformation_scale,
                     high_mode_scale,
                     estimate_floor,
+                    slab_stiffening_ratio,
                 })
             }
             b => {

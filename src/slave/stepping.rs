@@ -2,7 +2,7 @@
 
 use super::auto_features::{
     carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
-    linear_reach_exceeded, LINEAR_AT, NOT_QUIET,
+    linear_reach_exceeded, slab_stiffening_due, LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -114,7 +114,7 @@ impl Slave {
             taken = (n, h);
             // The rung of the steps taken: coarser rungs than the communication step are its.
             let taken_level = level.max(level_of_step(self.parameters.step_size, h));
-            if let Err(e) = self.prepare_step(h) {
+            if let Err(e) = self.prepare_step(h, big_h, before.features.frames) {
                 break Err(e);
             }
             backed_up = true;
@@ -137,7 +137,13 @@ impl Slave {
                 .is_none();
                 carry_over_logged = true;
                 // The slabs' own prestress is that of the state carried over to them.
-                choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
+                choose_slab_stiffening(
+                    model,
+                    dynamics,
+                    self.parameters.accuracy,
+                    &mut self.events,
+                    true,
+                );
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -479,7 +485,7 @@ impl Slave {
     /// are set before): the factorization for `h` (on a cache miss; an error here leaves the
     /// state), the terms in force, the geometric stiffness of the current prestress and the
     /// backup.
-    fn prepare_step(&mut self, h: f64) -> Result<()> {
+    fn prepare_step(&mut self, h: f64, big_h: f64, slab_state: bool) -> Result<()> {
         self.prepare_step_size(h)?;
         let motion = self.motion_frame();
         let dynamics = self.dynamics.as_mut().unwrap();
@@ -502,9 +508,18 @@ impl Slave {
             driven.as_ref(),
             &mut self.events,
         );
-        // Before the slabs may come on: where they do, their state is the one carried over to
-        // them, and `do_step` refreshes (and decides) after the carry-over.
-        choose_slab_stiffening(model, dynamics, self.parameters.accuracy, &mut self.events);
+        // Before the slabs may come on, and measured only on their own state (`slab_state`: the
+        // slabs were in force at the communication step's start). Where they come on, the
+        // state is the one carried over to them, and `do_step` measures after the carry-over.
+        let measure =
+            slab_state && slab_stiffening_due(model, dynamics, self.parameters.accuracy, big_h);
+        choose_slab_stiffening(
+            model,
+            dynamics,
+            self.parameters.accuracy,
+            &mut self.events,
+            measure,
+        );
         choose_features(
             model,
             dynamics,
@@ -602,6 +617,7 @@ impl Slave {
         }
         before.restore_scales(dynamics);
         dynamics.estimate_floor = before.estimate_floor;
+        dynamics.slab_stiffening_ratio = before.slab_stiffening_ratio;
         dynamics.features = before.features;
         dynamics.quiet_since = before.quiet_since;
         if let Some(model) = self.model.as_mut() {
@@ -645,6 +661,7 @@ struct StepStart {
     deformation_scale: f64,
     high_mode_scale: f64,
     estimate_floor: f64,
+    slab_stiffening_ratio: f64,
     features: super::Features,
     quiet_since: [f64; 3],
     /// The log events queued before the step: the decisions it logged after them
@@ -658,6 +675,7 @@ impl StepStart {
             deformation_scale: dynamics.deformation_scale,
             high_mode_scale: dynamics.high_mode_scale,
             estimate_floor: dynamics.estimate_floor,
+            slab_stiffening_ratio: dynamics.slab_stiffening_ratio,
             features: dynamics.features,
             quiet_since: dynamics.quiet_since,
             events,

@@ -19,7 +19,7 @@ pub(super) const SNAPSHOT_MAGIC: u64 = 0x666c_6578_6d75_7374; // "flexmust"
 /// state of another body or another version is refused by name.
 pub const SERIALIZED_MAGIC: &[u8; 8] = b"FLEXBODY";
 /// Version of the serialized layout (header and payload together: bump on any change).
-pub const SERIALIZED_FORMAT: u32 = 2;
+pub const SERIALIZED_FORMAT: u32 = 3;
 /// Fixed bytes of the header besides the GUID.
 const SERIALIZED_HEADER: usize = 8 + 4 + 4 + 1 + 1 + 8;
 
