@@ -276,7 +276,7 @@ impl Patches {
     /// much the stiffening changes the slabs' stiffness, the energy ratio
     /// `Σ_p |ū_pᵀ (G_p ⊗ I3) ū_p| / Σ_p ū_pᵀ K_p ū_p` (0 without deformation; on B3 it bounds the
     /// slabs' model error without it within 3×). No allocation.
-    pub fn update_stiffening(&mut self, x: &[f64], measure: bool) -> Option<f64> {
+    pub fn update_stiffening(&mut self, x: &[f64], measure: bool, scale: f64) -> Option<f64> {
         let (mut elastic, mut stiffening_energy) = (0.0, 0.0);
         for patch in &mut self.patches {
             let Some(stiffening) = patch.stiffening.as_mut() else {
@@ -291,7 +291,7 @@ impl Patches {
                 let u = rt * (node(x, n) - frame.origin) - fw.reference_offsets[k];
                 set_node(ubar, k, &u);
             }
-            stiffening.update(ubar);
+            stiffening.update(ubar, if measure { 1.0 } else { scale });
             if measure {
                 let force = &mut self.update_scratch.1[..m];
                 patch.stiffness.mul_vec(ubar, force);

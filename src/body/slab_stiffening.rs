@@ -62,7 +62,7 @@ impl SlabStiffening {
 
     /// Refreshes `G_p` from the slab's local deformation `ubar` (m, flat over its local nodes).
     /// No allocation.
-    pub fn update(&mut self, ubar: &[f64]) {
+    pub fn update(&mut self, ubar: &[f64], scale: f64) {
         for element in &mut self.elements {
             let (lambda, mu) = element.lame;
             // grad[r][c] = ∂ū_r/∂X_c, the element's mean.
@@ -75,7 +75,7 @@ impl SlabStiffening {
                     }
                 }
             }
-            let stress = fem::geometric::linear_stress(&grad, lambda, mu);
+            let stress = fem::geometric::linear_stress(&grad, lambda, mu).map(|s| s * scale);
             element.values.fill(0.0);
             for (s, unit) in stress.iter().zip(&element.unit) {
                 for (v, u) in element.values.iter_mut().zip(unit) {
@@ -149,7 +149,7 @@ mod tests {
             })
             .collect();
         let mut stiffening = SlabStiffening::new(&mesh, &vec![material; mesh.element_count()]);
-        stiffening.update(&ubar);
+        stiffening.update(&ubar, 1.0);
         let k_g = geometric_stiffness(&mesh, &stress_at_gauss_points(&mesh, &material, &ubar));
         let v: Vec<f64> = (0..ubar.len())
             .map(|k| 1e-3 * ((k * 7919 % 17) as f64 - 8.0))

@@ -45,8 +45,8 @@ pub struct Features {
     pub linear: bool,
     /// The slabs' own stiffening (docs/formulation.md, "Geometric stiffening within the
     /// slabs"): `model.auto`'s slabs take it once it changes their stiffness by more than
-    /// [`SWITCH_AT`](super::auto_features::SWITCH_AT) × `model.accuracy`; forced slabs with
-    /// `model.stiffening = stress` have it throughout.
+    /// [`SlabStiffeningSwitch::threshold`](super::auto_features::SlabStiffeningSwitch::threshold);
+    /// forced slabs with `model.stiffening = stress` have it throughout.
     pub slab_stiffening: bool,
 }
 

@@ -396,8 +396,9 @@ pub(super) fn carry_over_to_slabs(
 /// start; for `model.auto`'s slabs, where `measure` (see [`slab_stiffening_due`]) and the state
 /// is the slabs' own, measures how much their prestress changes their stiffness (the energy
 /// ratio of [`Patches::update_stiffening`], kept in `Dynamics::slab_stiffening_ratio`) and
-/// switches it on, once and for good, where that exceeds [`SWITCH_AT`] × `model.accuracy`;
-/// logged. No allocation unless the decision changes.
+/// switches it on, once and for good, where that exceeds [`SlabStiffeningSwitch::threshold`];
+/// logged. From the switch it comes in over the lowest period ([`slab_stiffening_scale`]). No
+/// allocation unless the decision changes.
 ///
 /// The caller passes `measure` false where the state is not the slabs' own: a communication
 /// step at which the slabs came on starts from the one frame's state, which the carry-over
@@ -408,7 +409,7 @@ pub(super) fn carry_over_to_slabs(
 pub(super) fn choose_slab_stiffening(
     model: &mut Model,
     dynamics: &mut Dynamics,
-    accuracy: f64,
+    switch: SlabStiffeningSwitch,
     events: &mut Vec<LogEvent>,
     measure: bool,
 ) {
@@ -420,24 +421,79 @@ pub(super) fn choose_slab_stiffening(
     if !(f.slab_stiffening || decides) {
         return;
     }
+    let scale = slab_stiffening_scale(model, dynamics);
     let Some(patches) = model.body.patches.as_mut().filter(|p| p.has_stiffening()) else {
         return;
     };
-    let Some(ratio) = patches.update_stiffening(&dynamics.state.position, decides) else {
+    let x = &dynamics.state.position;
+    let Some(ratio) = patches.update_stiffening(x, decides, scale) else {
         return;
     };
     dynamics.slab_stiffening_ratio = ratio;
-    if ratio > SWITCH_AT * accuracy {
+    if ratio > switch.threshold() {
+        // It comes in over the lowest period from here (`slab_stiffening_scale`).
+        dynamics.slab_stiffening_since = Some(dynamics.state.time);
+        patches.update_stiffening(x, false, 0.0);
         dynamics.features.slab_stiffening = true;
         model.apply_features(dynamics.features);
         events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "model.auto: at t = {} the slabs' own geometric stiffening switched on: their prestress changes their stiffness by {ratio:.3e} > {SWITCH_AT} × model.accuracy = {:e} (docs/formulation.md, \"Geometric stiffening within the slabs\")",
+                "model.auto: at t = {} the slabs' own geometric stiffening switched on, coming in over the lowest period: their prestress changes their stiffness by {ratio:.3e} > {SWITCH_AT} × model.accuracy / {:.3} = {:.3e} (the lowest mode's phase drift over the horizon; docs/formulation.md, \"Geometric stiffening within the slabs\")",
                 dynamics.state.time,
-                SWITCH_AT * accuracy
+                switch.drift,
+                switch.threshold()
             ),
         });
+    }
+}
+
+/// Where `model.auto` switches the slabs' own stiffening on (docs/formulation.md, "Geometric
+/// stiffening within the slabs"): where it changes their stiffness by more than
+/// [`SWITCH_AT`] × `model.accuracy` / `drift`. A stiffness left out by a share `r` is a static
+/// error of about `r` and shifts the lowest frequency by `r/2`, a phase that drifts by
+/// `ω₁ H r / 2` over the horizon `H`: `drift = max(1, ω₁ H / 2)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct SlabStiffeningSwitch {
+    /// `model.accuracy`.
+    pub accuracy: f64,
+    /// `max(1, ω₁ H / 2)`, 1 without a lowest mode or horizon.
+    pub drift: f64,
+}
+
+impl SlabStiffeningSwitch {
+    /// The switch for `accuracy` over the `horizon` (s) of a body whose lowest period is
+    /// `period` (s).
+    pub fn new(accuracy: f64, horizon: Option<f64>, period: Option<f64>) -> SlabStiffeningSwitch {
+        let drift = horizon
+            .zip(period)
+            .map_or(1.0, |(h, t1)| std::f64::consts::PI * h / t1)
+            .max(1.0);
+        SlabStiffeningSwitch {
+            accuracy,
+            drift: if drift.is_finite() { drift } else { 1.0 },
+        }
+    }
+
+    /// The energy ratio above which the stiffening is switched on.
+    pub fn threshold(&self) -> f64 {
+        SWITCH_AT * self.accuracy / self.drift
+    }
+}
+
+/// The share of the slabs' own stiffening in force at the state's time: it comes in linearly
+/// over the lowest period `T₁` from `model.auto`'s switch (`Dynamics::slab_stiffening_since`),
+/// a load that a step would have rung the body with. 1 where it was forced on.
+pub(super) fn slab_stiffening_scale(model: &Model, dynamics: &Dynamics) -> f64 {
+    let period = model
+        .lowest_modes
+        .as_ref()
+        .map_or(0.0, |modes| modes.first_period());
+    match dynamics.slab_stiffening_since {
+        Some(since) if period > 0.0 && period.is_finite() => {
+            ((dynamics.state.time - since) / period).clamp(0.0, 1.0)
+        }
+        _ => 1.0,
     }
 }
 
@@ -461,10 +517,10 @@ pub(super) const SLAB_STIFFENING_NEAR: f64 = 0.25;
 pub(super) fn slab_stiffening_due(
     model: &Model,
     dynamics: &Dynamics,
-    accuracy: f64,
+    switch: SlabStiffeningSwitch,
     big_h: f64,
 ) -> bool {
-    let near = dynamics.slab_stiffening_ratio > SLAB_STIFFENING_NEAR * SWITCH_AT * accuracy;
+    let near = dynamics.slab_stiffening_ratio > SLAB_STIFFENING_NEAR * switch.threshold();
     let interval = model
         .lowest_modes
         .as_ref()

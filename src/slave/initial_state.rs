@@ -108,7 +108,7 @@ impl Slave {
         let model = self.model.as_mut().unwrap();
         model.place_linear_body(&state.position);
         model.apply_features(features);
-        model.refresh_slab_stiffening(&state.position);
+        model.refresh_slab_stiffening(&state.position, 1.0);
         let body = &model.body;
         let gravity = Vector3::from(self.parameters.gravity);
         let interfaces = &self.interfaces;
@@ -138,6 +138,7 @@ impl Slave {
             high_mode_scale: 0.0,
             estimate_floor: 0.0,
             slab_stiffening_ratio: 0.0,
+            slab_stiffening_since: None,
         });
         if let Some(horizon) = self.error_horizon() {
             let over = match self.run_length() {

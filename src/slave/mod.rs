@@ -90,6 +90,9 @@ struct Dynamics {
     /// The slabs' stiffening ratio last measured while it was off (`choose_slab_stiffening`):
     /// near the switch it is measured at every communication step, otherwise once per `T₁/16`.
     slab_stiffening_ratio: f64,
+    /// When `model.auto` switched the slabs' own stiffening on (s; `None` where it was forced
+    /// on or is off): it comes in over the lowest period from then (`slab_stiffening_scale`).
+    slab_stiffening_since: Option<f64>,
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -605,6 +608,8 @@ impl Slave {
                 d.deformation_scale = s.deformation_scale;
                 d.high_mode_scale = s.high_mode_scale;
                 d.estimate_floor = s.estimate_floor;
+                d.slab_stiffening_ratio = s.slab_stiffening_ratio;
+                d.slab_stiffening_since = s.slab_stiffening_since;
             }
             (d, s) => *d = s.clone(),
         }
@@ -615,7 +620,8 @@ impl Slave {
         }
         if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
             model.apply_features(d.features);
-            model.refresh_slab_stiffening(&d.state.position);
+            let scale = auto_features::slab_stiffening_scale(model, d);
+            model.refresh_slab_stiffening(&d.state.position, scale);
         }
         self.outputs.invalidate();
         Ok(())

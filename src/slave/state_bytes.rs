@@ -246,6 +246,8 @@ impl SlaveState {
                 w.f64(d.high_mode_scale);
                 w.f64(d.estimate_floor);
                 w.f64(d.slab_stiffening_ratio);
+                w.u64(u64::from(d.slab_stiffening_since.is_some()));
+                w.f64(d.slab_stiffening_since.unwrap_or(0.0));
                 w.f64(s.step_size);
             }
         }
@@ -476,6 +478,9 @@ impl Slave {
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
                 let estimate_floor = r.f64("the estimate floor")?;
                 let slab_stiffening_ratio = r.f64("the slabs' stiffening ratio")?;
+                let ramped = r.u64("whether the slabs' stiffening came on at run time")? != 0;
+                let since = r.f64("when the slabs' stiffening came on")?;
+                let slab_stiffening_since = ramped.then_some(since);
                 for (scale, name) in [
                     (estimate_floor, "estimate floor"),
                     (deformation_scale, "deformation scale"),
@@ -520,6 +525,7 @@ impl Slave {
                     high_mode_scale,
                     estimate_floor,
                     slab_stiffening_ratio,
+                    slab_stiffening_since,
                 })
             }
             b => {

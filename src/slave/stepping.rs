@@ -2,7 +2,7 @@
 
 use super::auto_features::{
     carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
-    linear_reach_exceeded, slab_stiffening_due, LINEAR_AT, NOT_QUIET,
+    linear_reach_exceeded, slab_stiffening_due, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -106,6 +106,7 @@ impl Slave {
         // The slabs' carry-over is logged once, not per attempt.
         // Whether model.auto's slabs came on at this communication point (in this attempt).
         let (mut carry_over_logged, mut switch_rings, mut slabs_came_on) = (false, false, false);
+        let slab_switch = self.slab_stiffening_switch();
         let result = loop {
             let (n, h) = match self.internal_steps(big_h, level) {
                 Ok(step) => step,
@@ -137,13 +138,7 @@ impl Slave {
                 .is_none();
                 carry_over_logged = true;
                 // The slabs' own prestress is that of the state carried over to them.
-                choose_slab_stiffening(
-                    model,
-                    dynamics,
-                    self.parameters.accuracy,
-                    &mut self.events,
-                    true,
-                );
+                choose_slab_stiffening(model, dynamics, slab_switch, &mut self.events, true);
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -397,6 +392,16 @@ impl Slave {
         dynamics.deformation_scale = dynamics.deformation_scale.max(quasi_static);
     }
 
+    /// Where `model.auto` switches the slabs' own stiffening on, for this run's horizon.
+    fn slab_stiffening_switch(&self) -> SlabStiffeningSwitch {
+        let period = self
+            .model
+            .as_ref()
+            .and_then(|m| m.lowest_modes.as_ref())
+            .map(|modes| modes.first_period());
+        SlabStiffeningSwitch::new(self.parameters.accuracy, self.error_horizon(), period)
+    }
+
     /// The horizon `H` (s) over which the time error control lets the errors of its steps add
     /// up to `model.accuracy × D` (docs/formulation.md, "Time error control": the horizon): the
     /// run, `stopTime − startTime`, when the importer defined its stop time, else the period
@@ -487,6 +492,7 @@ impl Slave {
     /// backup.
     fn prepare_step(&mut self, h: f64, big_h: f64, slab_state: bool) -> Result<()> {
         self.prepare_step_size(h)?;
+        let slab_switch = self.slab_stiffening_switch();
         let motion = self.motion_frame();
         let dynamics = self.dynamics.as_mut().unwrap();
         let model = self
@@ -511,15 +517,8 @@ impl Slave {
         // Before the slabs may come on, and measured only on their own state (`slab_state`: the
         // slabs were in force at the communication step's start). Where they come on, the
         // state is the one carried over to them, and `do_step` measures after the carry-over.
-        let measure =
-            slab_state && slab_stiffening_due(model, dynamics, self.parameters.accuracy, big_h);
-        choose_slab_stiffening(
-            model,
-            dynamics,
-            self.parameters.accuracy,
-            &mut self.events,
-            measure,
-        );
+        let measure = slab_state && slab_stiffening_due(model, dynamics, slab_switch, big_h);
+        choose_slab_stiffening(model, dynamics, slab_switch, &mut self.events, measure);
         choose_features(
             model,
             dynamics,
@@ -618,6 +617,7 @@ impl Slave {
         before.restore_scales(dynamics);
         dynamics.estimate_floor = before.estimate_floor;
         dynamics.slab_stiffening_ratio = before.slab_stiffening_ratio;
+        dynamics.slab_stiffening_since = before.slab_stiffening_since;
         dynamics.features = before.features;
         dynamics.quiet_since = before.quiet_since;
         if let Some(model) = self.model.as_mut() {
@@ -662,6 +662,7 @@ struct StepStart {
     high_mode_scale: f64,
     estimate_floor: f64,
     slab_stiffening_ratio: f64,
+    slab_stiffening_since: Option<f64>,
     features: super::Features,
     quiet_since: [f64; 3],
     /// The log events queued before the step: the decisions it logged after them
@@ -676,6 +677,7 @@ impl StepStart {
             high_mode_scale: dynamics.high_mode_scale,
             estimate_floor: dynamics.estimate_floor,
             slab_stiffening_ratio: dynamics.slab_stiffening_ratio,
+            slab_stiffening_since: dynamics.slab_stiffening_since,
             features: dynamics.features,
             quiet_since: dynamics.quiet_since,
             events,

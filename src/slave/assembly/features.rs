@@ -32,12 +32,12 @@ impl Model {
     /// Refreshes the slabs' own stiffening `G_p` from `positions` (docs/formulation.md,
     /// "Geometric stiffening within the slabs") where the state is put in place without a step
     /// that would refresh it: a restored FMU state, the initial state. No allocation.
-    pub(in crate::slave) fn refresh_slab_stiffening(&mut self, positions: &[f64]) {
+    pub(in crate::slave) fn refresh_slab_stiffening(&mut self, positions: &[f64], scale: f64) {
         if self.body.reduction.is_some() {
             return;
         }
         if let Some(patches) = self.body.patches.as_mut().filter(|p| p.has_stiffening()) {
-            patches.update_stiffening(positions, false);
+            patches.update_stiffening(positions, false, scale);
         }
     }
 
