@@ -583,13 +583,30 @@ fn the_slabs_own_stiffening_is_part_of_the_state() {
         drive.step(&mut s, k as f64 * H, H).unwrap();
         log.extend(s.drain_events().map(|e| e.message));
     }
+    let switched = log
+        .iter()
+        .find(|m| m.contains("the slabs' own geometric stiffening switched on"))
+        .map(|m| logged_time(m))
+        .unwrap_or_else(|| {
+            panic!(
+                "{:?}",
+                log.iter()
+                    .filter(|m| m.starts_with("model.auto"))
+                    .collect::<Vec<_>>()
+            )
+        });
+    // Saved while it comes in: within the lowest period after the switch (the horizon's
+    // period, logged at initialization as there is no stop time).
+    let period: f64 = log
+        .iter()
+        .find_map(|m| m.split("T₁ = ").nth(1))
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .expect("the lowest period is logged");
+    let saved_at = 550.0 * H;
     assert!(
-        log.iter()
-            .any(|m| m.contains("the slabs' own geometric stiffening switched on")),
-        "{:?}",
-        log.iter()
-            .filter(|m| m.starts_with("model.auto"))
-            .collect::<Vec<_>>()
+        saved_at - period < switched && switched < saved_at,
+        "switched on at {switched} s, T₁ = {period} s, saved at {saved_at} s"
     );
     let mut saved = Vec::new();
     s.get_state().write_bytes(&mut saved);

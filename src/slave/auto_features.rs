@@ -513,14 +513,16 @@ pub(super) const SLAB_STIFFENING_NEAR: f64 = 0.25;
 
 /// Whether the communication step `[t, t + H)` measures the slabs' stiffening
 /// ([`SLAB_STIFFENING_CADENCE`]): it begins a new `T₁/16` of time, the last ratio was near the
-/// switch, or the body has no lowest period.
+/// switch, none was measured yet (0: the slabs' first step where the state could not be
+/// carried over to them), or the body has no lowest period.
 pub(super) fn slab_stiffening_due(
     model: &Model,
     dynamics: &Dynamics,
     switch: SlabStiffeningSwitch,
     big_h: f64,
 ) -> bool {
-    let near = dynamics.slab_stiffening_ratio > SLAB_STIFFENING_NEAR * switch.threshold();
+    let ratio = dynamics.slab_stiffening_ratio;
+    let near = ratio > SLAB_STIFFENING_NEAR * switch.threshold() || ratio == 0.0;
     let interval = model
         .lowest_modes
         .as_ref()
@@ -529,7 +531,7 @@ pub(super) fn slab_stiffening_due(
         return true;
     }
     let t = dynamics.state.time;
-    (t / interval).floor() < ((t + big_h) / interval).floor() || t == 0.0
+    (t / interval).floor() < ((t + big_h) / interval).floor()
 }
 
 /// `model.auto`'s slabs (one co-moving frame per element layer along the body's long axis,

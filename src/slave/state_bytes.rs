@@ -17,7 +17,7 @@
 //! | stop time | u8 (1: defined), f64 (0 when not) |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the slabs' stiffening ratio last measured f64; whether `model.auto` switched the slabs' own stiffening on: u8; when: f64 (0 when not); the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 13;
+pub const PAYLOAD_FORMAT: u32 = 14;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -246,7 +246,7 @@ impl SlaveState {
                 w.f64(d.high_mode_scale);
                 w.f64(d.estimate_floor);
                 w.f64(d.slab_stiffening_ratio);
-                w.u64(u64::from(d.slab_stiffening_since.is_some()));
+                w.u8(u8::from(d.slab_stiffening_since.is_some()));
                 w.f64(d.slab_stiffening_since.unwrap_or(0.0));
                 w.f64(s.step_size);
             }
@@ -478,10 +478,16 @@ impl Slave {
                 let high_mode_scale = r.f64("the scale of the modes above the lowest")?;
                 let estimate_floor = r.f64("the estimate floor")?;
                 let slab_stiffening_ratio = r.f64("the slabs' stiffening ratio")?;
-                let ramped = r.u64("whether the slabs' stiffening came on at run time")? != 0;
+                let ramped = r.boolean("whether model.auto switched the slabs' stiffening on")?;
                 let since = r.f64("when the slabs' stiffening came on")?;
+                if since > time {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state has the slabs' stiffening come on at t = {since}, after its time {time}"
+                    )));
+                }
                 let slab_stiffening_since = ramped.then_some(since);
                 for (scale, name) in [
+                    (slab_stiffening_ratio, "slabs' stiffening ratio"),
                     (estimate_floor, "estimate floor"),
                     (deformation_scale, "deformation scale"),
                     (high_mode_scale, "scale of the modes above the lowest"),

@@ -137,8 +137,10 @@ impl Slave {
                 )
                 .is_none();
                 carry_over_logged = true;
-                // The slabs' own prestress is that of the state carried over to them.
-                choose_slab_stiffening(model, dynamics, slab_switch, &mut self.events, true);
+                // The slabs' own prestress is that of the state carried over to them. A body
+                // it cannot carry over holds the one frame's state: measured at the next step.
+                let carried = !switch_rings;
+                choose_slab_stiffening(model, dynamics, slab_switch, &mut self.events, carried);
             }
             // With one internal step after an input jump nothing is estimated (see
             // `advance`): the deformation scale is not needed either.
@@ -167,6 +169,7 @@ impl Slave {
                 dynamics.features.frames = false;
                 dynamics.features.frames_refused = true;
                 dynamics.features.slab_stiffening = false;
+                dynamics.slab_stiffening_since = None;
                 let model = self.model.as_mut().unwrap();
                 model.apply_features(dynamics.features);
                 self.events.push(LogEvent {
