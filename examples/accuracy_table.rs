@@ -452,8 +452,7 @@ fn b3_section(quick: bool) {
     let controlled = controlled_rows(accuracies, &reference, |accuracy| {
         b3(&[("model.accuracy", accuracy)], end, 1e-2)
     });
-    compare_with_hand_chosen(&controlled, &hand);
-    paired_with_hand_chosen(
+    compare_with_hand_chosen(
         &controlled,
         &hand,
         quick,
@@ -495,8 +494,7 @@ fn rod_section(quick: bool) {
     let controlled = controlled_rows(accuracies, &reference, |accuracy| {
         conrod(&[("model.accuracy", accuracy)], end)
     });
-    compare_with_hand_chosen(&controlled, &hand);
-    paired_with_hand_chosen(
+    compare_with_hand_chosen(
         &controlled,
         &hand,
         quick,
@@ -555,8 +553,15 @@ fn controlled_rows(
 }
 
 /// The table of the controlled runs `(accuracy, wall, error)` against the cheapest hand-chosen
-/// setting whose error is at most the controlled run's, from the single runs above.
-fn compare_with_hand_chosen(controlled: &[(f64, f64, f64)], hand: &[HandChosen]) {
+/// setting whose error is at most the controlled run's, from the single runs above, then the
+/// same comparison from interleaved pairs ([`paired_with_hand_chosen`], with `ours` and `run`).
+fn compare_with_hand_chosen(
+    controlled: &[(f64, f64, f64)],
+    hand: &[HandChosen],
+    quick: bool,
+    ours: impl Fn(f64) -> Vec<(&'static str, f64)>,
+    run: impl Fn(&[(&str, f64)]) -> Run,
+) {
     println!(
         "\n| model.accuracy | error / peak | within? | wall (ms) | cheapest hand-chosen setting with at most that error | its wall (ms) | ours / it |"
     );
@@ -577,6 +582,7 @@ fn compare_with_hand_chosen(controlled: &[(f64, f64, f64)], hand: &[HandChosen])
             ),
         }
     }
+    paired_with_hand_chosen(controlled, hand, quick, ours, run);
 }
 
 /// The hand-chosen settings whose error is at most `error`, fastest first (by their single
@@ -683,8 +689,7 @@ fn b2_section(quick: bool) {
     let controlled = controlled_rows(&[1e-2, 1e-3, 1e-4], &reference, |accuracy| {
         timed(3, || b2(&[("model.accuracy", accuracy)], end))
     });
-    compare_with_hand_chosen(&controlled, &hand);
-    paired_with_hand_chosen(
+    compare_with_hand_chosen(
         &controlled,
         &hand,
         quick,

@@ -393,11 +393,11 @@ pub(super) fn carry_over_to_slabs(
 
 /// The slabs' own stiffening (docs/formulation.md, "Geometric stiffening within the slabs"):
 /// while it is in force, refreshes each slab's `G_p` from the state at the communication step's
-/// start; for `model.auto`'s slabs, where `measure` (see [`slab_stiffening_due`]) and the state
+/// start; for `model.auto`'s slabs, where `measure` (see [`SlabStiffeningSwitch::due`]) and the state
 /// is the slabs' own, measures how much their prestress changes their stiffness (the energy
 /// ratio of [`Patches::update_stiffening`], kept in `Dynamics::slab_stiffening_ratio`) and
 /// switches it on, once and for good, where that exceeds [`SlabStiffeningSwitch::threshold`];
-/// logged. From the switch it comes in over the lowest period ([`slab_stiffening_scale`]). No
+/// logged. From the switch it comes in over the lowest period ([`SlabStiffeningSwitch::scale`]). No
 /// allocation unless the decision changes.
 ///
 /// The caller passes `measure` false where the state is not the slabs' own: a communication
@@ -421,7 +421,7 @@ pub(super) fn choose_slab_stiffening(
     if !(f.slab_stiffening || decides) {
         return;
     }
-    let scale = slab_stiffening_scale(model, dynamics);
+    let scale = switch.scale(dynamics);
     let Some(patches) = model.body.patches.as_mut().filter(|p| p.has_stiffening()) else {
         return;
     };
@@ -431,7 +431,7 @@ pub(super) fn choose_slab_stiffening(
     };
     dynamics.slab_stiffening_ratio = ratio;
     if ratio > switch.threshold() {
-        // It comes in over the lowest period from here (`slab_stiffening_scale`).
+        // It comes in over the lowest period from here (`SlabStiffeningSwitch::scale`).
         dynamics.slab_stiffening_since = Some(dynamics.state.time);
         patches.update_stiffening(x, false, 0.0);
         dynamics.features.slab_stiffening = true;
@@ -448,21 +448,41 @@ pub(super) fn choose_slab_stiffening(
     }
 }
 
-/// Where `model.auto` switches the slabs' own stiffening on (docs/formulation.md, "Geometric
-/// stiffening within the slabs"): where it changes their stiffness by more than
-/// [`SWITCH_AT`] × `model.accuracy` / `drift`. A stiffness left out by a share `r` is a static
-/// error of about `r` and shifts the lowest frequency by `r/2`, a phase that drifts by
-/// `ω₁ H r / 2` over the horizon `H`: `drift = max(1, ω₁ H / 2)`.
+/// The rule of the slabs' own stiffening under `model.auto` (docs/formulation.md, "Geometric
+/// stiffening within the slabs"): where it is switched on, when it is measured while off, and
+/// how it comes in once on; all from `model.accuracy`, the horizon `H` and the lowest period
+/// `T₁`.
+///
+/// It is switched on where it changes the slabs' stiffness by more than [`SWITCH_AT`] ×
+/// `model.accuracy` / `drift`. A stiffness left out by a share `r` is a static error of about
+/// `r` and shifts the lowest frequency by `r/2`, a phase that drifts by `ω₁ H r / 2` over the
+/// horizon: `drift = max(1, ω₁ H / 2)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct SlabStiffeningSwitch {
     /// `model.accuracy`.
     pub accuracy: f64,
     /// `max(1, ω₁ H / 2)`, 1 without a lowest mode or horizon.
     pub drift: f64,
+    /// `T₁` (s); 0 without a lowest mode.
+    pub period: f64,
 }
 
+/// How often the slabs' stiffening is measured while it is off
+/// ([`SlabStiffeningSwitch::due`]): at the communication steps that begin a new
+/// `T₁ / SLAB_STIFFENING_CADENCE` of time, and at every communication step once the last ratio
+/// is above [`SLAB_STIFFENING_NEAR`] of the switch. The measurement is a product with every
+/// slab's stiffness: at every communication point it was 9 % of B3's run at
+/// `model.accuracy = 1e-2`. A ratio that grows from below the near mark to above the switch
+/// within `T₁/16` (its strain energy's share more than fourfold in a sixteenth of the lowest
+/// period) is caught at most that late.
+pub(super) const SLAB_STIFFENING_CADENCE: f64 = 16.0;
+
+/// The part of the switch above which the slabs' stiffening is measured at every communication
+/// step ([`SLAB_STIFFENING_CADENCE`]).
+pub(super) const SLAB_STIFFENING_NEAR: f64 = 0.25;
+
 impl SlabStiffeningSwitch {
-    /// The switch for `accuracy` over the `horizon` (s) of a body whose lowest period is
+    /// The rule for `accuracy` over the `horizon` (s) of a body whose lowest period is
     /// `period` (s).
     pub fn new(accuracy: f64, horizon: Option<f64>, period: Option<f64>) -> SlabStiffeningSwitch {
         let drift = horizon
@@ -472,6 +492,9 @@ impl SlabStiffeningSwitch {
         SlabStiffeningSwitch {
             accuracy,
             drift: if drift.is_finite() { drift } else { 1.0 },
+            period: period
+                .filter(|t1| *t1 > 0.0 && t1.is_finite())
+                .unwrap_or(0.0),
         }
     }
 
@@ -479,59 +502,33 @@ impl SlabStiffeningSwitch {
     pub fn threshold(&self) -> f64 {
         SWITCH_AT * self.accuracy / self.drift
     }
-}
 
-/// The share of the slabs' own stiffening in force at the state's time: it comes in linearly
-/// over the lowest period `T₁` from `model.auto`'s switch (`Dynamics::slab_stiffening_since`),
-/// a load that a step would have rung the body with. 1 where it was forced on.
-pub(super) fn slab_stiffening_scale(model: &Model, dynamics: &Dynamics) -> f64 {
-    let period = model
-        .lowest_modes
-        .as_ref()
-        .map_or(0.0, |modes| modes.first_period());
-    match dynamics.slab_stiffening_since {
-        Some(since) if period > 0.0 && period.is_finite() => {
-            ((dynamics.state.time - since) / period).clamp(0.0, 1.0)
+    /// The share of the slabs' own stiffening in force at the state's time: it comes in
+    /// linearly over `T₁` from `model.auto`'s switch (`Dynamics::slab_stiffening_since`), a load
+    /// that a step would have rung the body with. 1 where it was forced on.
+    pub fn scale(&self, dynamics: &Dynamics) -> f64 {
+        match dynamics.slab_stiffening_since {
+            Some(since) if self.period > 0.0 => {
+                ((dynamics.state.time - since) / self.period).clamp(0.0, 1.0)
+            }
+            _ => 1.0,
         }
-        _ => 1.0,
     }
-}
 
-/// How often the slabs' stiffening is measured while it is off
-/// (docs/formulation.md, "Geometric stiffening within the slabs"): at the communication steps
-/// that begin a new `T₁ / SLAB_STIFFENING_CADENCE` of time (`T₁` the lowest period), and at
-/// every communication step once the last ratio is above [`SLAB_STIFFENING_NEAR`] of the
-/// switch. The measurement is a product with every slab's stiffness: at every communication
-/// point it was 9 % of B3's run at `model.accuracy = 1e-2`. A ratio that grows from below the
-/// near mark to above the switch within `T₁/16` (its strain energy's share more than fourfold
-/// in a sixteenth of the lowest period) is caught at most that late.
-pub(super) const SLAB_STIFFENING_CADENCE: f64 = 16.0;
-
-/// The part of the switch above which the slabs' stiffening is measured at every communication
-/// step ([`SLAB_STIFFENING_CADENCE`]).
-pub(super) const SLAB_STIFFENING_NEAR: f64 = 0.25;
-
-/// Whether the communication step `[t, t + H)` measures the slabs' stiffening
-/// ([`SLAB_STIFFENING_CADENCE`]): it begins a new `T₁/16` of time, the last ratio was near the
-/// switch, none was measured yet (0: the slabs' first step where the state could not be
-/// carried over to them), or the body has no lowest period.
-pub(super) fn slab_stiffening_due(
-    model: &Model,
-    dynamics: &Dynamics,
-    switch: SlabStiffeningSwitch,
-    big_h: f64,
-) -> bool {
-    let ratio = dynamics.slab_stiffening_ratio;
-    let near = ratio > SLAB_STIFFENING_NEAR * switch.threshold() || ratio == 0.0;
-    let interval = model
-        .lowest_modes
-        .as_ref()
-        .map_or(0.0, |modes| modes.first_period() / SLAB_STIFFENING_CADENCE);
-    if near || !(interval > 0.0 && interval.is_finite()) {
-        return true;
+    /// Whether the communication step `[t, t + H)` measures the slabs' stiffening
+    /// ([`SLAB_STIFFENING_CADENCE`]): it begins a new `T₁/16` of time, the last ratio was near
+    /// the switch, none was measured yet (0: the slabs' first step where the state could not
+    /// be carried over to them), or the body has no lowest period.
+    pub fn due(&self, dynamics: &Dynamics, big_h: f64) -> bool {
+        let ratio = dynamics.slab_stiffening_ratio;
+        let near = ratio > SLAB_STIFFENING_NEAR * self.threshold() || ratio == 0.0;
+        let interval = self.period / SLAB_STIFFENING_CADENCE;
+        if near || interval <= 0.0 {
+            return true;
+        }
+        let t = dynamics.state.time;
+        (t / interval).floor() < ((t + big_h) / interval).floor()
     }
-    let t = dynamics.state.time;
-    (t / interval).floor() < ((t + big_h) / interval).floor()
 }
 
 /// `model.auto`'s slabs (one co-moving frame per element layer along the body's long axis,

@@ -91,7 +91,7 @@ struct Dynamics {
     /// near the switch it is measured at every communication step, otherwise once per `T₁/16`.
     slab_stiffening_ratio: f64,
     /// When `model.auto` switched the slabs' own stiffening on (s; `None` where it was forced
-    /// on or is off): it comes in over the lowest period from then (`slab_stiffening_scale`).
+    /// on or is off): it comes in over the lowest period from then (`SlabStiffeningSwitch::scale`).
     slab_stiffening_since: Option<f64>,
 }
 
@@ -618,9 +618,10 @@ impl Slave {
             let x0 = self.rigid_placement_positions()?;
             self.model.as_mut().unwrap().place_linear_body(&x0);
         }
+        let slab_switch = self.slab_stiffening_switch();
         if let (Some(model), Some(d)) = (self.model.as_mut(), self.dynamics.as_ref()) {
             model.apply_features(d.features);
-            let scale = auto_features::slab_stiffening_scale(model, d);
+            let scale = slab_switch.scale(d);
             model.refresh_slab_stiffening(&d.state.position, scale);
         }
         self.outputs.invalidate();

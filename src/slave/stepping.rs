@@ -2,7 +2,7 @@
 
 use super::auto_features::{
     carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
-    linear_reach_exceeded, slab_stiffening_due, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET,
+    linear_reach_exceeded, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -115,7 +115,8 @@ impl Slave {
             taken = (n, h);
             // The rung of the steps taken: coarser rungs than the communication step are its.
             let taken_level = level.max(level_of_step(self.parameters.step_size, h));
-            if let Err(e) = self.prepare_step(h, big_h, before.features.frames) {
+            let slab_state = before.features.frames;
+            if let Err(e) = self.prepare_step(h, big_h, slab_switch, slab_state) {
                 break Err(e);
             }
             backed_up = true;
@@ -396,7 +397,7 @@ impl Slave {
     }
 
     /// Where `model.auto` switches the slabs' own stiffening on, for this run's horizon.
-    fn slab_stiffening_switch(&self) -> SlabStiffeningSwitch {
+    pub(in crate::slave) fn slab_stiffening_switch(&self) -> SlabStiffeningSwitch {
         let period = self
             .model
             .as_ref()
@@ -493,9 +494,14 @@ impl Slave {
     /// are set before): the factorization for `h` (on a cache miss; an error here leaves the
     /// state), the terms in force, the geometric stiffness of the current prestress and the
     /// backup.
-    fn prepare_step(&mut self, h: f64, big_h: f64, slab_state: bool) -> Result<()> {
+    fn prepare_step(
+        &mut self,
+        h: f64,
+        big_h: f64,
+        slab_switch: SlabStiffeningSwitch,
+        slab_state: bool,
+    ) -> Result<()> {
         self.prepare_step_size(h)?;
-        let slab_switch = self.slab_stiffening_switch();
         let motion = self.motion_frame();
         let dynamics = self.dynamics.as_mut().unwrap();
         let model = self
@@ -520,7 +526,7 @@ impl Slave {
         // Before the slabs may come on, and measured only on their own state (`slab_state`: the
         // slabs were in force at the communication step's start). Where they come on, the
         // state is the one carried over to them, and `do_step` measures after the carry-over.
-        let measure = slab_state && slab_stiffening_due(model, dynamics, slab_switch, big_h);
+        let measure = slab_state && slab_switch.due(dynamics, big_h);
         choose_slab_stiffening(model, dynamics, slab_switch, &mut self.events, measure);
         choose_features(
             model,
