@@ -181,6 +181,55 @@ fn the_slabs_own_stiffening_takes_most_of_their_model_error() {
     );
 }
 
+#[test]
+fn a_redone_step_decides_the_slabs_stiffening_on_its_own_state() {
+    // B3 at `model.accuracy = 1e-3` with the run's stop time (20 s: the slabs' stiffening
+    // switches at 0.25 × 1e-3 / 38 = 6.6e-6), to 2 s. The slabs come on at 1.68 s, and that
+    // communication step is tried on 2.5 ms, then on 0.625 ms (rejected: its estimate did not
+    // fall, which teaches the estimate floor), then taken on 2.5 ms again. Each attempt carries
+    // the state over to the slabs with its own rung's iteration matrix. The 0.625 ms attempt's
+    // carry-over, stopped after its 50 corrections, read the slabs' stiffening at 3.56e-5, and
+    // the stiffening came on from a state the run threw away; the accepted attempt's reads it
+    // below the switch, as the first attempt's on the same rung did. A redone attempt decides
+    // again on its own state (docs/formulation.md, "Geometric stiffening within the slabs"):
+    // the stiffening stays off through the slabs' step (measured: it comes on at 3.11 s).
+    let mut s = flexbody::slave::Slave::from_body(b3_body()).unwrap();
+    s.setup_experiment(0.0, Some(20.0), None).unwrap();
+    s.enter_initialization_mode().unwrap();
+    set(&mut s, "model.accuracy", 1e-3);
+    s.exit_initialization_mode().unwrap();
+    let drive = common::b3::HubDrive::new(&s);
+    let mut log = Vec::new();
+    // Communication steps redone at the slabs' point.
+    let mut redone_at_slabs = 0;
+    for k in 0..200 {
+        let rejected = s.rejected_steps();
+        drive.step(&mut s, k as f64 * H, H).unwrap();
+        let events: Vec<String> = s.drain_events().map(|e| e.message).collect();
+        if events
+            .iter()
+            .any(|m| m.contains("carried over to the slabs"))
+        {
+            redone_at_slabs = s.rejected_steps() - rejected;
+        }
+        log.extend(events.into_iter().filter(|m| m.starts_with("model.auto")));
+    }
+    let slabs = log
+        .iter()
+        .find(|m| m.contains("carried over to the slabs"))
+        .map(|m| logged_time(m))
+        .expect("the slabs came on");
+    assert!((1.6..1.8).contains(&slabs), "slabs at {slabs} s");
+    // The scene this test is about: the slabs' step was redone (the finer rung, then the rung
+    // it came from).
+    assert!(redone_at_slabs >= 1, "{redone_at_slabs} redone");
+    let on: Vec<&String> = log
+        .iter()
+        .filter(|m| m.contains("the slabs' own geometric stiffening switched on"))
+        .collect();
+    assert!(on.is_empty(), "{on:?}");
+}
+
 /// The time `t` of a `model.auto: at t = … ` decision.
 fn logged_time(message: &str) -> f64 {
     message["model.auto: at t = ".len()..]

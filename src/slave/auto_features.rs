@@ -406,6 +406,10 @@ pub(super) fn carry_over_to_slabs(
 /// the carried-over state read 2.4e-8).
 ///
 /// [`Patches::update_stiffening`]: crate::body::patches::Patches::update_stiffening
+/// The words of the log message of the slabs' own stiffening switched on (a redone attempt
+/// withdraws it).
+pub(super) const SLAB_STIFFENING_ON: &str = "the slabs' own geometric stiffening switched on";
+
 pub(super) fn choose_slab_stiffening(
     model: &mut Model,
     dynamics: &mut Dynamics,
@@ -439,7 +443,7 @@ pub(super) fn choose_slab_stiffening(
         events.push(LogEvent {
             category: category::EVENTS,
             message: format!(
-                "model.auto: at t = {} the slabs' own geometric stiffening switched on, coming in over the lowest period: their prestress changes their stiffness by {ratio:.3e} > {SWITCH_AT} × model.accuracy / {:.3} = {:.3e} (the lowest mode's phase drift over the horizon; docs/formulation.md, \"Geometric stiffening within the slabs\")",
+                "model.auto: at t = {} {SLAB_STIFFENING_ON}, coming in over the lowest period: their prestress changes their stiffness by {ratio:.3e} > {SWITCH_AT} × model.accuracy / {:.3} = {:.3e} (the lowest mode's phase drift over the horizon; docs/formulation.md, \"Geometric stiffening within the slabs\")",
                 dynamics.state.time,
                 switch.drift,
                 switch.threshold()

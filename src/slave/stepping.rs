@@ -2,7 +2,7 @@
 
 use super::auto_features::{
     carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
-    linear_reach_exceeded, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET,
+    linear_reach_exceeded, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET, SLAB_STIFFENING_ON,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -254,7 +254,11 @@ impl Slave {
                         ),
                     });
                     dynamics.state.copy_from(self.backup.as_ref().unwrap());
-                    before.restore_scales(dynamics);
+                    before.restore_attempt(
+                        dynamics,
+                        self.model.as_mut().unwrap(),
+                        &mut self.events,
+                    );
                     level = first_level;
                     refined_from = None;
                     continue;
@@ -292,7 +296,7 @@ impl Slave {
                 let backup = self.backup.as_ref().unwrap();
                 let dynamics = self.dynamics.as_mut().unwrap();
                 dynamics.state.copy_from(backup);
-                before.restore_scales(dynamics);
+                before.restore_attempt(dynamics, self.model.as_mut().unwrap(), &mut self.events);
                 if !probing && refined_from.is_none() {
                     refined_from = Some((level, taken_level, ratio));
                 }
@@ -697,5 +701,30 @@ impl StepStart {
     fn restore_scales(&self, dynamics: &mut super::Dynamics) {
         dynamics.deformation_scale = self.deformation_scale;
         dynamics.high_mode_scale = self.high_mode_scale;
+    }
+
+    /// Before a rejected attempt is redone on another rung: the scales as they were, and the
+    /// slabs' own stiffening as it was, decided again on the redo's own carried-over state
+    /// (an attempt's carry-over depends on its rung, and a rejected attempt's state is no part
+    /// of the run; docs/formulation.md, "Geometric stiffening within the slabs"), its message
+    /// withdrawn.
+    fn restore_attempt(
+        &self,
+        dynamics: &mut super::Dynamics,
+        model: &mut super::assembly::Model,
+        events: &mut Vec<LogEvent>,
+    ) {
+        self.restore_scales(dynamics);
+        if dynamics.features.slab_stiffening != self.features.slab_stiffening {
+            dynamics.features.slab_stiffening = self.features.slab_stiffening;
+            dynamics.slab_stiffening_since = self.slab_stiffening_since;
+            dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
+            model.apply_features(dynamics.features);
+            let mut index = 0;
+            events.retain(|event| {
+                index += 1;
+                index <= self.events || !event.message.contains(SLAB_STIFFENING_ON)
+            });
+        }
     }
 }
