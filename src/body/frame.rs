@@ -21,38 +21,6 @@ pub(super) fn add_outer(m: &mut Matrix3<f64>, a: &Vector3<f64>, b: &Vector3<f64>
     }
 }
 
-/// The motion of the nodes relative to the body's rigid motion (docs/formulation.md, "The
-/// errors that last": the free vibration above the lowest modes). With the rigid velocity field
-/// nearest to `v`, `v_c + Ω × r`, `r = x − c` ([`nearest_rigid_field`] over `nodes`, weights
-/// `weight`), the relative velocity is `v_rel = v − v_c − Ω × r` (m/s) and the relative
-/// acceleration `a_rel = a − Ω × (Ω × r) − 2 Ω × v_rel − (a_c + α × r)` (m/s²), `a_c + α × r` the
-/// rigid field nearest to what is left: the spin's centripetal and Coriolis accelerations are
-/// the frame's, not the body's. Written into `v_rel` and `a_rel` (flat `3N`, global; zero
-/// outside `nodes`). No allocation.
-pub fn relative_motion(
-    nodes: &[usize],
-    weight: impl Fn(usize) -> f64 + Copy,
-    x: &[f64],
-    (v, a): (&[f64], &[f64]),
-    (v_rel, a_rel): (&mut [f64], &mut [f64]),
-) {
-    let (centre, v_c, omega) = nearest_rigid_field(nodes, weight, x, |i| node(v, i));
-    v_rel.fill(0.0);
-    a_rel.fill(0.0);
-    for &i in nodes {
-        let r = node(x, i) - centre;
-        let relative = node(v, i) - v_c - omega.cross(&r);
-        let left = node(a, i) - omega.cross(&omega.cross(&r)) - 2.0 * omega.cross(&relative);
-        set_node(v_rel, i, &relative);
-        set_node(a_rel, i, &left);
-    }
-    let (centre, a_c, alpha) = nearest_rigid_field(nodes, weight, x, |i| node(a_rel, i));
-    for &i in nodes {
-        let rigid = a_c + alpha.cross(&(node(x, i) - centre));
-        add_node(a_rel, i, &-rigid);
-    }
-}
-
 /// The rigid field `t + θ × (x − c)` nearest to a field `f` over `nodes` in the weighted
 /// least-squares sense, `Σ_i w_i |t + θ × (x_i − c) − f_i|²` (weights `weight(k) ≥ 0` of the
 /// `k`-th of `nodes`, positions `x` flat `3N`): `c` and `t` the weighted means of `x_i` and
@@ -326,40 +294,6 @@ pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
 mod tests {
     use super::*;
     use nalgebra::Rotation3;
-
-    #[test]
-    fn the_relative_motion_takes_out_the_spin_with_its_centripetal_and_coriolis_terms() {
-        // Five nodes, not coplanar, equal weights; the rigid motion `v_c + Ω × r`,
-        // `a_c + α × r + Ω × (Ω × r)` about their centroid `c`, and a relative stretch `s r` at
-        // the rate `b r` (no rigid part: its nearest rigid field about the centroid is zero),
-        // whose acceleration seen from outside adds the Coriolis term `2 Ω × (s r)`.
-        let x = [
-            0.0, 0.0, 0.0, 1.0, 0.2, 0.0, 0.1, 1.3, 0.4, -0.3, 0.5, 1.1, 0.7, -0.6, 0.2,
-        ];
-        let nodes: Vec<usize> = (0..5).collect();
-        let c = (0..5).map(|i| node(&x, i)).sum::<Vector3<f64>>() / 5.0;
-        let (omega, alpha) = (Vector3::new(0.3, -0.5, 2.0), Vector3::new(0.1, 0.2, -0.3));
-        let (v_c, a_c) = (Vector3::new(1.0, -2.0, 0.5), Vector3::new(-0.4, 0.3, 9.0));
-        let (s, b) = (0.05, -0.02);
-        let (mut v, mut a) = (vec![0.0; 15], vec![0.0; 15]);
-        for i in 0..5 {
-            let r = node(&x, i) - c;
-            set_node(&mut v, i, &(v_c + omega.cross(&r) + s * r));
-            let outside = a_c
-                + alpha.cross(&r)
-                + omega.cross(&omega.cross(&r))
-                + 2.0 * omega.cross(&(s * r))
-                + b * r;
-            set_node(&mut a, i, &outside);
-        }
-        let (mut v_rel, mut a_rel) = (vec![0.0; 15], vec![0.0; 15]);
-        relative_motion(&nodes, |_| 1.0, &x, (&v, &a), (&mut v_rel, &mut a_rel));
-        for i in 0..5 {
-            let r = node(&x, i) - c;
-            assert!((node(&v_rel, i) - s * r).norm() < 1e-14, "{i}: {v_rel:?}");
-            assert!((node(&a_rel, i) - b * r).norm() < 1e-13, "{i}: {a_rel:?}");
-        }
-    }
 
     #[test]
     fn the_angle_between_two_rotations_is_that_of_their_turn() {

@@ -21,9 +21,8 @@
 //!   `w_j = min(1, 1/(σ_j H))` ([`LowestModes::lasting_error`]). The modes above the kept ones
 //!   get the weight of the lowest of them, `ω_top` (they decay at least as fast).
 
-use super::frame::{node, relative_motion, FrameWeights};
+use super::frame::node;
 use crate::fem::modal::EigenPairs;
-use crate::linalg::cholesky::{SolveWorkspace, SparseCholesky};
 use crate::linalg::SymmetricCsr;
 use nalgebra::Matrix3;
 
@@ -54,36 +53,6 @@ pub struct LowestModes {
     decay_rates: [f64; MODES + 1],
     /// The body's mass `m` (kg).
     total_mass: f64,
-    /// The static response on the free nodes, for the free vibration above the lowest modes
-    /// ([`Self::free_vibration`]); `None` where it is not set ([`Self::with_static_response`]).
-    static_response: Option<std::sync::Arc<StaticResponse>>,
-}
-
-/// The static response `K⁻¹ f` on the free nodes (docs/formulation.md, "The errors that last").
-struct StaticResponse {
-    /// `K` of the free DOFs factored (`K + σ M` on a body without supports, `σ` far below `ω₁²`).
-    factor: SparseCholesky,
-    /// `M` of the free DOFs.
-    mass: SymmetricCsr,
-    /// A body without supports: its rigid modes `ψ_r` and `M ψ_r` (mass-normalised, free DOFs),
-    /// taken out of a field before a solve (`K + σ M` magnifies them by `1/σ`).
-    rigid: Vec<(Vec<f64>, Vec<f64>)>,
-}
-
-impl std::fmt::Debug for StaticResponse {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "StaticResponse({} DOFs)", self.mass.n)
-    }
-}
-
-/// The workspace of [`LowestModes::free_vibration`] ([`LowestModes::free_vibration_scratch`]).
-pub struct FreeVibrationScratch {
-    solve: SolveWorkspace,
-    x: Vec<f64>,
-    y: Vec<f64>,
-    z: Vec<f64>,
-    /// The relative velocities and accelerations (flat `3N`, the body's size).
-    relative: (Vec<f64>, Vec<f64>),
 }
 
 impl LowestModes {
@@ -136,149 +105,6 @@ impl LowestModes {
             omega_top_sq,
             decay_rates,
             total_mass,
-            static_response: None,
-        }
-    }
-
-    /// The same with the static response on the free nodes set: `factor` is `K` of the free DOFs
-    /// factored (the one of the modal analysis: `K + σ M` on a body without supports), `mass`
-    /// their `M`, and `pairs`' first `rigid` modes the rigid ones. Allocates; set-up only.
-    pub fn with_static_response(
-        mut self,
-        factor: SparseCholesky,
-        mass: &SymmetricCsr,
-        pairs: &EigenPairs,
-        rigid: usize,
-    ) -> LowestModes {
-        let rigid = pairs.modes[..rigid.min(pairs.modes.len())]
-            .iter()
-            .map(|psi| {
-                let mut m_psi = vec![0.0; psi.len()];
-                mass.mul_vec(psi, &mut m_psi);
-                (psi.clone(), m_psi)
-            })
-            .collect();
-        self.static_response = Some(std::sync::Arc::new(StaticResponse {
-            factor,
-            mass: mass.clone(),
-            rigid,
-        }));
-        self
-    }
-
-    /// Whether the static response is set ([`Self::with_static_response`]).
-    pub fn has_static_response(&self) -> bool {
-        self.static_response.is_some()
-    }
-
-    /// The workspace of [`Self::free_vibration`]; `None` without the static response.
-    /// Allocates; set-up only.
-    pub fn free_vibration_scratch(&self, size: usize) -> Option<FreeVibrationScratch> {
-        let response = self.static_response.as_ref()?;
-        let n = response.mass.n;
-        Some(FreeVibrationScratch {
-            solve: response.factor.solve_scratch(),
-            x: vec![0.0; n],
-            y: vec![0.0; n],
-            z: vec![0.0; n],
-            relative: (vec![0.0; size], vec![0.0; size]),
-        })
-    }
-
-    /// [`Self::free_vibration`] of the state `(x, v, a)` (flat `3N` of `size`, global): its
-    /// motion relative to the rigid motion of the frame weights' nodes
-    /// ([`crate::body::frame::relative_motion`]), in the co-moving frame `rotation`. No
-    /// allocation.
-    pub fn free_vibration_of(
-        &self,
-        weights: &FrameWeights,
-        rotation: &Matrix3<f64>,
-        (x, v, a): (&[f64], &[f64], &[f64]),
-        scratch: &mut FreeVibrationScratch,
-    ) -> Option<f64> {
-        let (mut v_rel, mut a_rel) = std::mem::take(&mut scratch.relative);
-        relative_motion(
-            &weights.nodes,
-            |k| weights.weights[k],
-            x,
-            (v, a),
-            (&mut v_rel, &mut a_rel),
-        );
-        let amplitude = self.free_vibration(rotation, &a_rel, scratch);
-        scratch.relative = (v_rel, a_rel);
-        amplitude
-    }
-
-    /// The displacement of the free vibration above the lowest modes (m, mass-weighted RMS),
-    /// from the nodes' accelerations `a_rel` relative to the body's rigid motion (flat `3N`,
-    /// global; `rotation` `R`, the co-moving frame's; [`crate::body::frame::relative_motion`]).
-    /// In a mode `j` of the body frame, `q̈_j + ω_j² q_j = f_j`: the displacement beyond the
-    /// static response to the load is `q_j − f_j/ω_j² = −q̈_j/ω_j²`, the free vibration's.
-    /// Over the modes above the kept ones,
-    ///
-    /// ```text
-    /// free² = Σ_j q̈_j²/ω_j⁴ / m = zᵀ M z / m,   z = K⁻¹ M a_rel
-    /// ```
-    ///
-    /// one solve with the static factor, the field's parts in the kept modes (and a free
-    /// body's rigid modes) taken out first. It swings between 0 and the amplitude with each
-    /// mode's phase: the largest value seen over a run bounds the amplitude (a velocity term
-    /// `Σ q̇_j²/ω_j²` would read it at once, but `q̇_j` holds the rate of the static response
-    /// too, which on B3's spin-up is a hundred times the free vibration). `None` without the
-    /// static response. No allocation.
-    pub fn free_vibration(
-        &self,
-        rotation: &Matrix3<f64>,
-        a_rel: &[f64],
-        scratch: &mut FreeVibrationScratch,
-    ) -> Option<f64> {
-        let response = self.static_response.as_deref()?;
-        let FreeVibrationScratch { solve, x, y, z, .. } = scratch;
-        self.above_kept_modes(response, rotation, a_rel, x);
-        response.mass.mul_vec(x, y);
-        z.copy_from_slice(y);
-        response.factor.solve_in_place(z, solve);
-        response.mass.mul_vec(z, y);
-        let squared = crate::linalg::dot(z, y);
-        Some((squared.max(0.0) / self.total_mass).sqrt())
-    }
-
-    /// `x ← Rᵀv` on the free nodes without its parts in the rigid modes and the kept ones (each
-    /// `φ (φᵀ M x)`, `M`-orthogonal); `y` scratch. No allocation.
-    fn above_kept_modes(
-        &self,
-        response: &StaticResponse,
-        rotation: &Matrix3<f64>,
-        v: &[f64],
-        x: &mut [f64],
-    ) {
-        let rt = rotation.transpose();
-        for (k, &i) in self.nodes.iter().enumerate() {
-            x[3 * k..3 * k + 3].copy_from_slice((rt * node(v, i)).as_slice());
-        }
-        for (psi, m_psi) in &response.rigid {
-            let c = crate::linalg::dot(m_psi, x);
-            for (x, psi) in x.iter_mut().zip(psi) {
-                *x -= c * psi;
-            }
-        }
-        let n = self.nodes.len();
-        let mut p = [0.0; MODES];
-        for k in 0..n {
-            let psi = &self.mass_modes[3 * MODES * k..3 * MODES * (k + 1)];
-            for (j, p) in p.iter_mut().enumerate() {
-                *p += psi[3 * j] * x[3 * k]
-                    + psi[3 * j + 1] * x[3 * k + 1]
-                    + psi[3 * j + 2] * x[3 * k + 2];
-            }
-        }
-        for k in 0..n {
-            let phi = &self.modes[3 * MODES * k..3 * MODES * (k + 1)];
-            for (j, p) in p.iter().enumerate() {
-                for c in 0..3 {
-                    x[3 * k + c] -= p * phi[3 * j + c];
-                }
-            }
         }
     }
 
@@ -495,49 +321,6 @@ mod tests {
             iterations: 1,
         };
         LowestModes::new(&[0, 1], &mass, &pairs, 0, 2.0, damping)
-    }
-
-    #[test]
-    fn the_free_vibration_is_the_static_response_to_the_relative_inertia_above_the_kept_modes() {
-        // Three unit masses on springs to ground, k = 1, 4 and 9 N/m in every direction: the
-        // six kept modes are nodes 0 and 1 (ω² = 1 and 4), the modes above node 2's (ω² = 9).
-        // In a mode above, `q − f/ω² = −q̈/ω²`: an acceleration 3 m/s² along x at node 2 is
-        // a free vibration of 3/9 m there, RMS over the 3 kg √((1/3)² / 3); accelerations
-        // in the kept modes add nothing.
-        let identity: Vec<_> = (0..9).map(|i| (i, i, 1.0)).collect();
-        let mass = SymmetricCsr::from_triplets(9, &identity);
-        let stiffness: Vec<_> = (0..9).map(|i| (i, i, [1.0, 4.0, 9.0][i / 3])).collect();
-        let stiffness = SymmetricCsr::from_triplets(9, &stiffness);
-        let unit = |i: usize| {
-            let mut e = vec![0.0; 9];
-            e[i] = 1.0;
-            e
-        };
-        let pairs = EigenPairs {
-            eigenvalues: vec![1.0, 1.0, 1.0, 4.0, 4.0, 4.0, 9.0],
-            modes: (0..7).map(unit).collect(),
-            iterations: 1,
-        };
-        let factor = SparseCholesky::new(&stiffness).unwrap();
-        let modes = LowestModes::new(&[0, 1, 2], &mass, &pairs, 0, 3.0, (0.0, 0.0))
-            .with_static_response(factor, &mass, &pairs, 0);
-        let mut scratch = modes.free_vibration_scratch(9).unwrap();
-        let expected = (1.0f64 / 3.0) / 3.0f64.sqrt();
-        let a = [5.0, -1.0, 2.0, 0.5, 7.0, 0.0, 3.0, 0.0, 0.0];
-        let found = modes.free_vibration(&Matrix3::identity(), &a, &mut scratch);
-        assert!((found.unwrap() - expected).abs() < 1e-15, "{found:?}");
-        // The same field seen from a frame turned by 90° about z.
-        let turn = Matrix3::new(0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0);
-        let mut turned = [0.0; 9];
-        for i in 0..3 {
-            let v = turn * nalgebra::Vector3::new(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
-            turned[3 * i..3 * i + 3].copy_from_slice(v.as_slice());
-        }
-        let found = modes.free_vibration(&turn, &turned, &mut scratch);
-        assert!((found.unwrap() - expected).abs() < 1e-15, "{found:?}");
-        // Without the static response there is nothing to say.
-        let plain = LowestModes::new(&[0, 1, 2], &mass, &pairs, 0, 3.0, (0.0, 0.0));
-        assert!(plain.free_vibration_scratch(9).is_none());
     }
 
     #[test]

@@ -50,18 +50,6 @@ pub fn lowest_eigenpairs(
     tolerance: f64,
     max_iterations: usize,
 ) -> Result<EigenPairs> {
-    lowest_eigenpairs_factored(k, m, count, tolerance, max_iterations).map(|(pairs, _)| pairs)
-}
-
-/// [`lowest_eigenpairs`], and the Cholesky factor of `K` it used (whose solves give the static
-/// response `K⁻¹ f`).
-pub fn lowest_eigenpairs_factored(
-    k: &SymmetricCsr,
-    m: &SymmetricCsr,
-    count: usize,
-    tolerance: f64,
-    max_iterations: usize,
-) -> Result<(EigenPairs, SparseCholesky)> {
     let n = k.n;
     if m.n != n {
         return Err(Error::new(format!(
@@ -158,14 +146,11 @@ pub fn lowest_eigenpairs_factored(
             let modes = (0..count)
                 .map(|j| x.as_slice()[j * n..(j + 1) * n].to_vec())
                 .collect();
-            return Ok((
-                EigenPairs {
-                    eigenvalues: values[..count].to_vec(),
-                    modes,
-                    iterations: iteration,
-                },
-                factor,
-            ));
+            return Ok(EigenPairs {
+                eigenvalues: values[..count].to_vec(),
+                modes,
+                iterations: iteration,
+            });
         }
         previous = Some(values);
     }

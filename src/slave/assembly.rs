@@ -4,7 +4,7 @@
 use super::parameters::AssemblyKey;
 use super::{LogEvent, Slave};
 use crate::body::feature_indicators::FeatureIndicators;
-use crate::body::lowest_modes::{FreeVibrationScratch, LowestModes, MODES};
+use crate::body::lowest_modes::{LowestModes, MODES};
 use crate::body::stiffening::{geometric_stiffness_product, GeometricStiffening};
 use crate::body::strain_monitor::StrainMonitor;
 use crate::body::{
@@ -87,9 +87,6 @@ pub(super) struct Model {
     /// of the accelerations and the part of a field in these modes. `None` without error
     /// control.
     pub(super) lowest_modes: Option<LowestModes>,
-    /// The workspace of the free vibration above the lowest modes (`LowestModes::free_vibration`),
-    /// where the lowest modes hold the static response.
-    pub(super) free_vibration: Option<FreeVibrationScratch>,
     /// The step Jacobian's vectors, allocated on its first use (`Slave::step_jacobian`).
     pub(super) jacobian: Option<super::step_jacobian::JacobianWorkspace>,
     /// A reduced body's stiffening switched by `model.auto` from its driving motion: the twelve
@@ -570,12 +567,7 @@ impl Slave {
         let p = &self.parameters;
         let lowest_modes = (p.accuracy > 0.0 && p.integrator == Integrator::GeneralizedAlpha)
             .then(|| {
-                schemes::lowest_modes(
-                    &free,
-                    body.total_mass,
-                    (p.damping_alpha, p.damping_beta),
-                    body.reduction.is_none(),
-                )
+                schemes::lowest_modes(&free, body.total_mass, (p.damping_alpha, p.damping_beta))
             })
             .transpose()?
             .map(|modes| {
@@ -620,7 +612,6 @@ impl Slave {
         let p = &self.parameters;
         let monitored =
             p.formulation != Formulation::Full && p.frames == 1 && body.reduction.is_none();
-        let body_size = body.reference.len();
         self.model = Some(Model {
             key,
             body,
@@ -635,9 +626,6 @@ impl Slave {
             parked_geometric_stiffness: None,
             parked_patches,
             parked_linear: None,
-            free_vibration: lowest_modes
-                .as_ref()
-                .and_then(|m| m.free_vibration_scratch(body_size)),
             lowest_modes,
             jacobian: None,
             driven_stiffening,

@@ -292,19 +292,17 @@ impl Slave {
     /// frames of the motion interfaces there: the frame of the inputs, extrapolated from their
     /// sample time `t_s` to `t_0` (no allocation unless an input is rejected).
     ///
-    /// Returns whether an input jumps at `t_0`, whether a motion interface's does, and whether a
-    /// force interface's does: a motion
+    /// Returns whether an input jumps at `t_0`, and whether a motion interface's does: a motion
     /// interface's frame (pose or velocities) differs from the previous step's frame carried on
     /// to `t_0`, or a force interface set at `t_0` differs from the loads the state's
     /// accelerations belong to. The step after a jump starts from a kink of the driving motion
     /// or the load, which no internal step can resolve (the error control does not estimate its
     /// error, nor that of the next internal steps after a motion input's jump:
     /// `slave::step_control::MOTION_RINGING_STEPS`).
-    pub(super) fn update_driving_frames(&mut self) -> Result<(bool, bool, bool)> {
+    pub(super) fn update_driving_frames(&mut self) -> Result<(bool, bool)> {
         let t = self.time();
         let mut jumped = false;
         let mut motion_jumped = false;
-        let mut force_jumped = false;
         let last = self.last_step_size;
         for (k, interface) in self.interfaces.iter().enumerate() {
             let age = t - self.input_times[k];
@@ -359,13 +357,13 @@ impl Slave {
                 }
                 InterfaceKind::Force if age == 0.0 => {
                     if let Some(d) = &self.dynamics {
-                        force_jumped |= self.inputs[k][..6] != d.loads[k][..6];
+                        jumped |= self.inputs[k][..6] != d.loads[k][..6];
                     }
                 }
                 _ => {}
             }
         }
-        Ok((jumped || force_jumped, motion_jumped, force_jumped))
+        Ok((jumped, motion_jumped))
     }
 
     /// The driving frame of the motion interface as it stands at the start of the current step,

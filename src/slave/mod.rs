@@ -81,11 +81,8 @@ struct Dynamics {
     /// The deformation scale `D` (m): the largest mass-weighted RMS elastic displacement seen so
     /// far, or quasi-static displacement of the accelerations ([`step_control`]).
     deformation_scale: f64,
-    /// `A` (m): the largest seen so far of the bound on the amplitude of the modes above the
-    /// lowest: their free vibration (the static response to the relative inertia,
-    /// `LowestModes::free_vibration`), or all of their displacement (its energy over `ω₇²`) in
-    /// a communication step whose loads jumped and where the static response is not at hand
-    /// ([`step_control`]; docs/formulation.md, "The errors that last").
+    /// `A` (m): the largest seen so far of the bound on the mass-weighted RMS of the elastic
+    /// displacement's part above the lowest modes (its energy over `ω₇²`, [`step_control`]).
     high_mode_scale: f64,
     /// The estimate that refining did not reduce (m): the iteration's or the model's own noise
     /// in the estimate, below which the error control does not refine ([`step_control`]).
@@ -216,10 +213,6 @@ pub struct Slave {
     step_estimate: f64,
     /// Whether an input jumped at the start of the communication step under way.
     inputs_jumped: bool,
-    /// Whether a force interface's inputs jumped at the current step's start (a load's step:
-    /// the modes above the lowest are bounded by all of their displacement in that step,
-    /// `stepping::internal_steps::HighModeBound`).
-    loads_jumped: bool,
     /// Internal steps since a motion input last jumped, at the start of the communication step
     /// under way (`step_control::MOTION_RINGING_STEPS`).
     since_motion_jump: u32,
@@ -326,7 +319,6 @@ impl Slave {
             step_error_unfloored: 0.0,
             step_estimate: 0.0,
             inputs_jumped: false,
-            loads_jumped: false,
             since_motion_jump: 0,
             scale_scratch: Vec::new(),
             events: Vec::new(),

@@ -13,7 +13,7 @@ use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
-use internal_steps::{observe_deformation, HighModeBound};
+use internal_steps::observe_deformation;
 
 mod internal_steps;
 mod run_warnings;
@@ -49,8 +49,7 @@ impl Slave {
         // the next step whether its inputs jump).
         self.driving_before.copy_from_slice(&self.driving);
         let motion_jumped;
-        (self.inputs_jumped, motion_jumped, self.loads_jumped) = match self.update_driving_frames()
-        {
+        (self.inputs_jumped, motion_jumped) = match self.update_driving_frames() {
             Ok(jumped) => jumped,
             Err(e) => {
                 self.driving.copy_from_slice(&self.driving_before);
@@ -604,12 +603,6 @@ impl Slave {
                 &mut model.forces,
                 &mut self.scale_scratch,
                 dynamics,
-                match model.free_vibration.as_mut() {
-                    Some(scratch) if !(self.loads_jumped || t0 == self.start_time) => {
-                        HighModeBound::FreeVibration(scratch)
-                    }
-                    _ => HighModeBound::Displacement,
-                },
             );
         }
         self.outputs.invalidate();
@@ -722,94 +715,16 @@ impl StepStart {
         events: &mut Vec<LogEvent>,
     ) {
         self.restore_scales(dynamics);
-        if self.undo_slab_stiffening(dynamics, events) {
+        if dynamics.features.slab_stiffening != self.features.slab_stiffening {
+            dynamics.features.slab_stiffening = self.features.slab_stiffening;
+            dynamics.slab_stiffening_since = self.slab_stiffening_since;
+            dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
             model.apply_features(dynamics.features);
+            let mut index = 0;
+            events.retain(|event| {
+                index += 1;
+                index <= self.events || !event.message.contains(SLAB_STIFFENING_ON)
+            });
         }
-    }
-
-    /// The slabs' own stiffening as it was at the step's start, if the attempt switched it
-    /// (flag, switch time and ratio), its message withdrawn; whether it did.
-    fn undo_slab_stiffening(
-        &self,
-        dynamics: &mut super::Dynamics,
-        events: &mut Vec<LogEvent>,
-    ) -> bool {
-        if dynamics.features.slab_stiffening == self.features.slab_stiffening {
-            return false;
-        }
-        dynamics.features.slab_stiffening = self.features.slab_stiffening;
-        dynamics.slab_stiffening_since = self.slab_stiffening_since;
-        dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
-        let mut index = 0;
-        events.retain(|event| {
-            index += 1;
-            index <= self.events || !event.message.contains(SLAB_STIFFENING_ON)
-        });
-        true
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::step_control::Ladder;
-    use super::super::{Dynamics, Features, LogEvent};
-    use super::*;
-    use crate::solver::problem::DynamicState;
-
-    #[test]
-    fn a_redone_attempt_undoes_the_slabs_stiffening_its_rejected_attempt_switched_on() {
-        // An attempt switched the slabs' own stiffening on at 1.68 s (ratio 3.6e-5, logged) and
-        // was rejected: its redo starts from the step's decision, off, with the ratio and the
-        // message before it (B3 at 1e-3 on 20 elements did this from a 0.625 ms attempt's
-        // carry-over before the modes above the lowest were bounded by their free vibration;
-        // docs/formulation.md, "Geometric stiffening within the slabs").
-        let mut dynamics = Dynamics {
-            state: DynamicState::zeros(3, 0),
-            loads: Vec::new(),
-            gravity: [0.0; 3],
-            features: Features {
-                frames: true,
-                ..Features::default()
-            },
-            quiet_since: [NOT_QUIET; 3],
-            ladder: Ladder::default(),
-            deformation_scale: 1.0,
-            high_mode_scale: 0.0,
-            estimate_floor: 0.0,
-            slab_stiffening_ratio: 2.0e-6,
-            slab_stiffening_since: None,
-        };
-        let event = |message: &str| LogEvent {
-            category: category::EVENTS,
-            message: message.to_string(),
-        };
-        let mut events = vec![event("model.auto: at t = 1.68 the state is carried over")];
-        let start = StepStart::of(&dynamics, events.len());
-        dynamics.features.slab_stiffening = true;
-        dynamics.slab_stiffening_since = Some(1.68);
-        dynamics.slab_stiffening_ratio = 3.6e-5;
-        events.push(event(&format!(
-            "model.auto: at t = 1.68 {SLAB_STIFFENING_ON}, …"
-        )));
-        events.push(event("model.accuracy: the step from t = 1.68 … redone"));
-        assert!(start.undo_slab_stiffening(&mut dynamics, &mut events));
-        assert!(!dynamics.features.slab_stiffening && dynamics.features.frames);
-        assert_eq!(dynamics.slab_stiffening_since, None);
-        assert_eq!(dynamics.slab_stiffening_ratio, 2.0e-6);
-        let messages: Vec<&str> = events.iter().map(|e| e.message.as_str()).collect();
-        assert_eq!(
-            messages,
-            [
-                "model.auto: at t = 1.68 the state is carried over",
-                "model.accuracy: the step from t = 1.68 … redone"
-            ]
-        );
-        // An attempt that decided nothing leaves the decision as it is.
-        assert!(!start.undo_slab_stiffening(&mut dynamics, &mut events));
-        // Nor does it undo a decision the step started with.
-        dynamics.features.slab_stiffening = true;
-        let on = StepStart::of(&dynamics, events.len());
-        assert!(!on.undo_slab_stiffening(&mut dynamics, &mut events));
-        assert!(dynamics.features.slab_stiffening);
     }
 }

@@ -162,7 +162,6 @@ pub(super) fn lowest_modes(
     free: &FreeNodes,
     total_mass: f64,
     damping: (f64, f64),
-    mesh_body: bool,
 ) -> Result<LowestModes> {
     let supported = !free.clamped.is_empty();
     let (k_full, m_full) = free.elastic_matrices();
@@ -190,13 +189,12 @@ pub(super) fn lowest_modes(
     };
     let shifted = SymmetricCsr::linear_combination(1.0, k, shift, m);
     let count = (index + LOWEST_MODES + 1).min(k.n);
-    let (mut pairs, factor) = fem::modal::lowest_eigenpairs_factored(&shifted, m, count, 1e-6, 200)
-        .map_err(|e| {
-            Error::new(format!(
-                "model.accuracy: the lowest natural frequency: {}",
-                e.message
-            ))
-        })?;
+    let mut pairs = fem::modal::lowest_eigenpairs(&shifted, m, count, 1e-6, 200).map_err(|e| {
+        Error::new(format!(
+            "model.accuracy: the lowest natural frequency: {}",
+            e.message
+        ))
+    })?;
     pairs
         .eigenvalues
         .iter_mut()
@@ -214,21 +212,14 @@ pub(super) fn lowest_modes(
             "model.accuracy: the lowest natural frequency came out as {omega} rad/s; set model.accuracy = 0 for a fixed internal step"
         )));
     }
-    let modes = LowestModes::new(
+    Ok(LowestModes::new(
         &free.nodes[..free.elastic_nodes],
         &m_full,
         &pairs,
         index,
         total_mass,
         damping,
-    );
-    // The static response for the free vibration above the lowest modes (docs/formulation.md,
-    // "The errors that last"): the mesh's nodes, whose rigid motion is a field of the positions,
-    // without rigid sets (their analysis runs in other coordinates).
-    Ok(match (mesh_body, &motions) {
-        (true, None) => modes.with_static_response(factor, &m_full, &pairs, index),
-        _ => modes,
-    })
+    ))
 }
 
 /// `Tᵀ A T` of a symmetric `A` (dense: a reduced body's size).

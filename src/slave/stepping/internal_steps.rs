@@ -9,7 +9,7 @@ use super::super::step_control::{
 };
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
-use crate::body::lowest_modes::{FreeVibrationScratch, LowestModes};
+use crate::body::lowest_modes::LowestModes;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
 use crate::solver::problem::{DynamicState, IterationSettings, StepProblem};
@@ -122,10 +122,6 @@ impl Slave {
             estimate_error: None,
         };
         let jumped = self.inputs_jumped;
-        // A communication step whose loads jumped, or the first, bounds the modes above the
-        // lowest by all of their displacement, from its first estimated step on
-        // (`HighModeBound::Displacement`).
-        let displacement_bound = self.loads_jumped || t0 == self.start_time;
         // Internal steps since a motion input's jump before this call's first (within a
         // communication step counted in this attempt's steps, `hs`, halved on a retry; across
         // communication steps in the accepted attempt's).
@@ -218,11 +214,6 @@ impl Slave {
                     &mut model.forces,
                     &mut self.scale_scratch,
                     dynamics,
-                    if displacement_bound {
-                        HighModeBound::Displacement
-                    } else {
-                        HighModeBound::Unchanged
-                    },
                 );
                 let rotation = body
                     .frame_weights
@@ -341,7 +332,6 @@ pub(super) fn observe_deformation(
     forces: &mut crate::solver::problem::ResidualWorkspace,
     y: &mut [f64],
     dynamics: &mut super::super::Dynamics,
-    bound: HighModeBound,
 ) {
     // With patches the strain energy is theirs: the one frame's `ūᵀ K ū` holds its own
     // spurious strain of the slabs' turns (`θ²/2`, axial), an energy in the stiff modes that
@@ -359,41 +349,5 @@ pub(super) fn observe_deformation(
         modes.deformation(energy, elastic_force)
     });
     dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
-    // `A` bounds what the errors above the lowest modes can add up to (docs/formulation.md,
-    // "The errors that last").
-    let amplitude = match bound {
-        HighModeBound::Unchanged if modes.has_static_response() => return,
-        HighModeBound::FreeVibration(scratch) => {
-            let state = &dynamics.state;
-            let weights = &body.frame_weights;
-            let rotation = weights.best_fit(&state.position).rotation;
-            modes.free_vibration_of(
-                weights,
-                &rotation,
-                (&state.position, &state.velocity, &state.acceleration),
-                scratch,
-            )
-        }
-        _ => None,
-    };
-    dynamics.high_mode_scale = dynamics.high_mode_scale.max(amplitude.unwrap_or(above));
-}
-
-/// What bounds the amplitude `A` of the modes above the lowest at an observation
-/// ([`observe_deformation`]; docs/formulation.md, "The errors that last").
-pub(super) enum HighModeBound<'a> {
-    /// After an estimated internal step of a communication step that bounds them by their free
-    /// vibration: `A` is left to its end where the lowest modes hold the static response, else
-    /// all of the displacement above them.
-    Unchanged,
-    /// All of the displacement above the lowest modes (their energy over `ω_top²`): at the end
-    /// of a communication step whose inputs jumped, or the first, where a load came on at once.
-    /// Steps that do not resolve the modes it sets ringing (the implicit scheme takes them to
-    /// their static response at once) would leave no free vibration to see, where the true
-    /// motion has one as large as the jump's static response.
-    Displacement,
-    /// The free vibration above the lowest modes, from the relative accelerations
-    /// ([`LowestModes::free_vibration_of`]); all of the displacement where the static response
-    /// is not at hand.
-    FreeVibration(&'a mut FreeVibrationScratch),
+    dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
 }
