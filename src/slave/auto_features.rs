@@ -391,6 +391,10 @@ pub(super) fn carry_over_to_slabs(
     Some(carried)
 }
 
+/// The words of the log message of the slabs' own stiffening switched on (a redone attempt
+/// withdraws it).
+pub(super) const SLAB_STIFFENING_ON: &str = "the slabs' own geometric stiffening switched on";
+
 /// The slabs' own stiffening (docs/formulation.md, "Geometric stiffening within the slabs"):
 /// while it is in force, refreshes each slab's `G_p` from the state at the communication step's
 /// start; for `model.auto`'s slabs, where `measure` (see [`SlabStiffeningSwitch::due`]) and the state
@@ -406,10 +410,6 @@ pub(super) fn carry_over_to_slabs(
 /// the carried-over state read 2.4e-8).
 ///
 /// [`Patches::update_stiffening`]: crate::body::patches::Patches::update_stiffening
-/// The words of the log message of the slabs' own stiffening switched on (a redone attempt
-/// withdraws it).
-pub(super) const SLAB_STIFFENING_ON: &str = "the slabs' own geometric stiffening switched on";
-
 pub(super) fn choose_slab_stiffening(
     model: &mut Model,
     dynamics: &mut Dynamics,

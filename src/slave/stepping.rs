@@ -715,10 +715,11 @@ impl StepStart {
         events: &mut Vec<LogEvent>,
     ) {
         self.restore_scales(dynamics);
+        // A rejected attempt's measurement is no part of the run either (it feeds `due`).
+        dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
         if dynamics.features.slab_stiffening != self.features.slab_stiffening {
             dynamics.features.slab_stiffening = self.features.slab_stiffening;
             dynamics.slab_stiffening_since = self.slab_stiffening_since;
-            dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
             model.apply_features(dynamics.features);
             let mut index = 0;
             events.retain(|event| {
