@@ -2,7 +2,7 @@
 
 use super::auto_features::{
     carry_over_to_slabs, choose_driven_stiffening, choose_features, choose_slab_stiffening,
-    linear_reach_exceeded, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET, SLAB_STIFFENING_ON,
+    linear_reach_exceeded, SlabStiffeningSwitch, LINEAR_AT, NOT_QUIET,
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
@@ -14,9 +14,11 @@ use crate::body::stiffening::driven_inertial_coefficients;
 use crate::error::{Error, ErrorKind, Result};
 use crate::model::category;
 use internal_steps::observe_deformation;
+use step_start::StepStart;
 
 mod internal_steps;
 mod run_warnings;
+mod step_start;
 
 /// How often an internal step that did not converge is retried with halved internal steps
 /// (2, 4, ..., 2^MAX_STEP_HALVINGS steps in its place) before the communication step is
@@ -664,68 +666,4 @@ impl Slave {
 /// the counters).
 fn is_decision(message: &str) -> bool {
     message.starts_with("model.auto:") || message.starts_with("model.accuracy:")
-}
-
-/// What a communication step may change besides the state and the driving frames, as it was at
-/// its start: a failed step puts all of it back, a redone attempt the scales (a rejected
-/// attempt's state, an unresolved ringing's overshoot among others, must not loosen the
-/// allowance of its redo).
-struct StepStart {
-    deformation_scale: f64,
-    high_mode_scale: f64,
-    estimate_floor: f64,
-    slab_stiffening_ratio: f64,
-    slab_stiffening_since: Option<f64>,
-    features: super::Features,
-    quiet_since: [f64; 3],
-    /// The log events queued before the step: the decisions it logged after them
-    /// (`model.auto`'s switches, `model.accuracy`'s rungs) are undone with it.
-    events: usize,
-}
-
-impl StepStart {
-    fn of(dynamics: &super::Dynamics, events: usize) -> StepStart {
-        StepStart {
-            deformation_scale: dynamics.deformation_scale,
-            high_mode_scale: dynamics.high_mode_scale,
-            estimate_floor: dynamics.estimate_floor,
-            slab_stiffening_ratio: dynamics.slab_stiffening_ratio,
-            slab_stiffening_since: dynamics.slab_stiffening_since,
-            features: dynamics.features,
-            quiet_since: dynamics.quiet_since,
-            events,
-        }
-    }
-
-    /// `D` and `A` as they were.
-    fn restore_scales(&self, dynamics: &mut super::Dynamics) {
-        dynamics.deformation_scale = self.deformation_scale;
-        dynamics.high_mode_scale = self.high_mode_scale;
-    }
-
-    /// Before a rejected attempt is redone on another rung: the scales as they were, and the
-    /// slabs' own stiffening as it was, decided again on the redo's own carried-over state
-    /// (an attempt's carry-over depends on its rung, and a rejected attempt's state is no part
-    /// of the run; docs/formulation.md, "Geometric stiffening within the slabs"), its message
-    /// withdrawn.
-    fn restore_attempt(
-        &self,
-        dynamics: &mut super::Dynamics,
-        model: &mut super::assembly::Model,
-        events: &mut Vec<LogEvent>,
-    ) {
-        self.restore_scales(dynamics);
-        // A rejected attempt's measurement is no part of the run either (it feeds `due`).
-        dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
-        if dynamics.features.slab_stiffening != self.features.slab_stiffening {
-            dynamics.features.slab_stiffening = self.features.slab_stiffening;
-            dynamics.slab_stiffening_since = self.slab_stiffening_since;
-            model.apply_features(dynamics.features);
-            let mut index = 0;
-            events.retain(|event| {
-                index += 1;
-                index <= self.events || !event.message.contains(SLAB_STIFFENING_ON)
-            });
-        }
-    }
 }

@@ -1,0 +1,69 @@
+//! What a communication step puts back when it fails or redoes an attempt (docs/formulation.md,
+//! "Time error control" and "Geometric stiffening within the slabs").
+
+use super::super::auto_features::SLAB_STIFFENING_ON;
+use super::super::LogEvent;
+
+/// What a communication step may change besides the state and the driving frames, as it was at
+/// its start: a failed step puts all of it back, a redone attempt the scales (a rejected
+/// attempt's state, an unresolved ringing's overshoot among others, must not loosen the
+/// allowance of its redo).
+pub(super) struct StepStart {
+    pub(super) deformation_scale: f64,
+    pub(super) high_mode_scale: f64,
+    pub(super) estimate_floor: f64,
+    pub(super) slab_stiffening_ratio: f64,
+    pub(super) slab_stiffening_since: Option<f64>,
+    pub(super) features: super::super::Features,
+    pub(super) quiet_since: [f64; 3],
+    /// The log events queued before the step: the decisions it logged after them
+    /// (`model.auto`'s switches, `model.accuracy`'s rungs) are undone with it.
+    pub(super) events: usize,
+}
+
+impl StepStart {
+    pub(super) fn of(dynamics: &super::super::Dynamics, events: usize) -> StepStart {
+        StepStart {
+            deformation_scale: dynamics.deformation_scale,
+            high_mode_scale: dynamics.high_mode_scale,
+            estimate_floor: dynamics.estimate_floor,
+            slab_stiffening_ratio: dynamics.slab_stiffening_ratio,
+            slab_stiffening_since: dynamics.slab_stiffening_since,
+            features: dynamics.features,
+            quiet_since: dynamics.quiet_since,
+            events,
+        }
+    }
+
+    /// `D` and `A` as they were.
+    pub(super) fn restore_scales(&self, dynamics: &mut super::super::Dynamics) {
+        dynamics.deformation_scale = self.deformation_scale;
+        dynamics.high_mode_scale = self.high_mode_scale;
+    }
+
+    /// Before a rejected attempt is redone on another rung: the scales as they were, and the
+    /// slabs' own stiffening as it was, decided again on the redo's own carried-over state
+    /// (an attempt's carry-over depends on its rung, and a rejected attempt's state is no part
+    /// of the run; docs/formulation.md, "Geometric stiffening within the slabs"), its message
+    /// withdrawn.
+    pub(super) fn restore_attempt(
+        &self,
+        dynamics: &mut super::super::Dynamics,
+        model: &mut super::super::assembly::Model,
+        events: &mut Vec<LogEvent>,
+    ) {
+        self.restore_scales(dynamics);
+        // A rejected attempt's measurement is no part of the run either (it feeds `due`).
+        dynamics.slab_stiffening_ratio = self.slab_stiffening_ratio;
+        if dynamics.features.slab_stiffening != self.features.slab_stiffening {
+            dynamics.features.slab_stiffening = self.features.slab_stiffening;
+            dynamics.slab_stiffening_since = self.slab_stiffening_since;
+            model.apply_features(dynamics.features);
+            let mut index = 0;
+            events.retain(|event| {
+                index += 1;
+                index <= self.events || !event.message.contains(SLAB_STIFFENING_ON)
+            });
+        }
+    }
+}
