@@ -629,24 +629,12 @@ impl Slave {
         if backed_up {
             dynamics.state.copy_from(self.backup.as_ref().unwrap());
         }
-        before.restore_scales(dynamics);
-        dynamics.estimate_floor = before.estimate_floor;
-        dynamics.slab_stiffening_ratio = before.slab_stiffening_ratio;
-        dynamics.slab_stiffening_since = before.slab_stiffening_since;
-        dynamics.features = before.features;
-        dynamics.quiet_since = before.quiet_since;
-        if let Some(model) = self.model.as_mut() {
-            model.apply_features(before.features);
-        }
+        before.restore(dynamics, self.model.as_mut());
         self.driving.copy_from_slice(&self.driving_before);
         self.outputs.invalidate();
         // The failed step's decisions are undone, and so are their messages (a switch logged
         // and rolled back would tell the importer of a model the next step does not use).
-        let mut index = 0;
-        self.events.retain(|event| {
-            index += 1;
-            index <= before.events || !is_decision(&event.message)
-        });
+        before.withdraw(&mut self.events, is_decision);
         let kind = e.kind;
         let message = format!(
             "doStep from t = {t_c} by communicationStepSize = {big_h}: {}; the state was rolled back to t = {t_c}{}",
