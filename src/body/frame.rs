@@ -263,12 +263,30 @@ impl FrameWeights {
 /// the skew part's axis, well conditioned at small angles) and, past π/2, from `cos θ`.
 pub fn angle_between(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
     let turn = a.transpose() * b;
-    let axis = Vector3::new(
-        turn[(2, 1)] - turn[(1, 2)],
-        turn[(0, 2)] - turn[(2, 0)],
-        turn[(1, 0)] - turn[(0, 1)],
-    );
-    (0.5 * axis.norm()).atan2(0.5 * (turn.trace() - 1.0))
+    (0.5 * skew_axis(&turn).norm()).atan2(0.5 * (turn.trace() - 1.0))
+}
+
+/// The axis of the skew part of a rotation `R`, `(R − Rᵀ)^∨ = 2 sin θ n`.
+fn skew_axis(r: &Matrix3<f64>) -> Vector3<f64> {
+    Vector3::new(
+        r[(2, 1)] - r[(1, 2)],
+        r[(0, 2)] - r[(2, 0)],
+        r[(1, 0)] - r[(0, 1)],
+    )
+}
+
+/// The rotation vector `φ = θ n` of a rotation `R = exp([φ]×)` (θ < π): from the skew part
+/// `2 sin θ n` and the angle of [`angle_between`], well conditioned at small angles (where it is
+/// the skew part's half).
+pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
+    let skew = skew_axis(r);
+    let sine = 0.5 * skew.norm();
+    let theta = sine.atan2(0.5 * (r.trace() - 1.0));
+    if sine < 1e-8 {
+        0.5 * skew
+    } else {
+        skew * (0.5 * theta / sine)
+    }
 }
 
 /// The left Jacobian of the rotation vector `φ`: `exp([φ + δ]×) = exp([J_l(φ) δ]×) exp([φ]×)` to

@@ -280,6 +280,19 @@ impl NodeSet {
 /// `φ = ω τ + α τ²/2`, velocity `v + a τ` and angular velocity `J_l(φ) φ̇`, the path's own
 /// (`J_l` the left Jacobian of the rotation vector; `ω + α τ` when `α ∥ ω`). Every time is
 /// measured from the inputs as given, so a frame carried over several steps is the frame of one.
+///
+/// A followed sample does not lie exactly on the path the frame was following: the rates'
+/// change bends it by `O(Δt³)` in the pose and `O(Δt²)` in the velocities. The held nodes would
+/// jump by that bend at the update, and a jump `δ` of a held position is an acceleration
+/// `δ/(β h²)` over the next internal step `h`, ringing in the scheme's update formulas: on B3 at
+/// `h = Δt/128`, 1 500 times the hub's own acceleration (docs/fmu.md, "Inputs are samples in
+/// time": the bend carried off). So the frame starts where the path it followed stood, `offset`
+/// (`δp`, `δθ`, `δv`, `δω`: that path's pose and velocities at `changed_at` less the sample's,
+/// the rotation as the vector of `Q_path Qᵀ`), and sheds it by `changed_at + rate_span` along the
+/// cubic `c(τ) = δ h₀₀(u) + δ̇ Δt h₁₀(u)`, `u = τ/Δt`, `h₀₀ = 2u³ − 3u² + 1`,
+/// `h₁₀ = u³ − 2u² + u` (continuous in pose and velocity at both ends): the pose `p + c_p`,
+/// `exp([c_θ]×) Q`, the velocities `v + ċ_p`, `ω + ċ_θ` (to first order in the offset) and the
+/// accelerations `a + c̈_p`, `α + c̈_θ`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DrivingFrame {
     pub position: Vector3<f64>,
@@ -293,6 +306,9 @@ pub struct DrivingFrame {
     /// zero when it keeps constant velocities.
     pub rate_span: f64,
     pub updated_at: f64,
+    /// The pose and velocities the frame starts with beyond the sample's and sheds over
+    /// `rate_span`: `[δp, δθ, δv, δω]` (m, rad, m/s, rad/s; zero unless it follows its rates).
+    pub offset: [Vector3<f64>; 4],
 }
 
 impl Default for DrivingFrame {
@@ -307,6 +323,7 @@ impl Default for DrivingFrame {
             changed_at: 0.0,
             rate_span: 0.0,
             updated_at: 0.0,
+            offset: [Vector3::zeros(); 4],
         }
     }
 }
@@ -329,18 +346,20 @@ impl DrivingFrame {
         self.angular_velocity * tau + alpha * (0.5 * tau * tau)
     }
 
-    /// Origin and rotation at `t`.
+    /// Origin and rotation at `t`, with what is left of the offset.
     pub fn at(&self, t: f64) -> (Vector3<f64>, Matrix3<f64>) {
         let tau = t - self.changed_at;
         let (a, _) = self.extrapolation_rates();
         let turn = nalgebra::Rotation3::from_scaled_axis(self.turn(t));
+        let [(c_p, _, _), (c_theta, _, _)] = self.shed_offset(t);
         (
-            self.position + self.velocity * tau + a * (0.5 * tau * tau),
-            turn.matrix() * self.rotation,
+            self.position + self.velocity * tau + a * (0.5 * tau * tau) + c_p,
+            nalgebra::Rotation3::from_scaled_axis(c_theta).matrix() * turn.matrix() * self.rotation,
         )
     }
 
-    /// Velocity and angular velocity at `t`: `v + a τ` and `J_l(φ) (ω + α τ)`.
+    /// Velocity and angular velocity at `t`: `v + a τ` and `J_l(φ) (ω + α τ)`, with what is left
+    /// of the offset.
     pub fn velocities_at(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let tau = t - self.changed_at;
         let (a, alpha) = self.extrapolation_rates();
@@ -349,12 +368,40 @@ impl DrivingFrame {
         } else {
             self.angular_velocity
         };
-        (self.velocity + a * tau, angular)
+        let [(_, dc_p, _), (_, dc_theta, _)] = self.shed_offset(t);
+        (self.velocity + a * tau + dc_p, angular + dc_theta)
     }
 
-    /// The frame as it stands at `t`, given anew there: pose and velocities at `t`, the same
-    /// rates (for what takes the motion at one time: a step's start, the inputs of an interface
-    /// set in part).
+    /// Acceleration and angular acceleration of the path at `t`: the rates the frame follows
+    /// and the offset's.
+    pub fn accelerations_at(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let (a, alpha) = self.extrapolation_rates();
+        let [(_, _, ddc_p), (_, _, ddc_theta)] = self.shed_offset(t);
+        (a + ddc_p, alpha + ddc_theta)
+    }
+
+    /// What is left at `t` of the offset, and its first and second time derivatives, for the
+    /// position and the rotation: `c(τ) = δ h₀₀(u) + δ̇ Δt h₁₀(u)`, `u = τ/Δt` (zero outside
+    /// `0 ≤ τ < Δt = rate_span`; the struct's documentation).
+    fn shed_offset(&self, t: f64) -> [(Vector3<f64>, Vector3<f64>, Vector3<f64>); 2] {
+        let zero = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
+        let Some([h00, h10]) = shedding(t - self.changed_at, self.rate_span) else {
+            return [zero; 2];
+        };
+        let [dp, dtheta, dv, domega] = self.offset;
+        let shed = |d: Vector3<f64>, e: Vector3<f64>| {
+            (
+                d * h00[0] + e * h10[0],
+                d * h00[1] + e * h10[1],
+                d * h00[2] + e * h10[2],
+            )
+        };
+        [shed(dp, dv), shed(dtheta, domega)]
+    }
+
+    /// The frame as it stands at `t`, given anew there: pose and velocities at `t` (the offset's
+    /// rest taken in), the same rates (for what takes the motion at one time: a step's start,
+    /// the inputs of an interface set in part).
     pub fn advanced_to(&self, t: f64) -> DrivingFrame {
         let (position, rotation) = self.at(t);
         let (velocity, angular_velocity) = self.velocities_at(t);
@@ -364,9 +411,33 @@ impl DrivingFrame {
             velocity,
             angular_velocity,
             changed_at: t,
+            offset: [Vector3::zeros(); 4],
             ..*self
         }
     }
+}
+
+/// The weights with which an offset is shed `τ` after it was taken, over `span` (s):
+/// `[h₀₀(u), Δt h₁₀(u)]` with `u = τ/Δt`, each with its first and second time derivatives
+/// (`DrivingFrame`: the offset `(δ, δ̇)` left is `δ h₀₀ + δ̇ Δt h₁₀`). `None` outside
+/// `0 ≤ τ < span` (nothing left) or without a span.
+pub fn shedding(tau: f64, span: f64) -> Option<[[f64; 3]; 2]> {
+    if !(span > 0.0 && (0.0..span).contains(&tau)) {
+        return None;
+    }
+    let u = tau / span;
+    Some([
+        [
+            2.0 * u * u * u - 3.0 * u * u + 1.0,
+            (6.0 * u * u - 6.0 * u) / span,
+            (12.0 * u - 6.0) / (span * span),
+        ],
+        [
+            span * (u * u * u - 2.0 * u * u + u),
+            3.0 * u * u - 4.0 * u + 1.0,
+            (6.0 * u - 4.0) / span,
+        ],
+    ])
 }
 
 impl NodeSet {
@@ -404,7 +475,7 @@ impl NodeSet {
     ) {
         let (p, q) = frame.at(t);
         let (velocity, w) = frame.velocities_at(t);
-        let (acceleration, alpha) = frame.extrapolation_rates();
+        let (acceleration, alpha) = frame.accelerations_at(t);
         self.for_each_held(reference, |index, offset, point| {
             let r = q * offset;
             let (x0, v0, a0) = if point {
@@ -527,6 +598,7 @@ mod tests {
             changed_at: 1.0,
             rate_span: 0.01,
             updated_at: 1.0,
+            offset: [Vector3::zeros(); 4],
         };
         let (t1, t2) = (1.013, 1.034);
         let (a, b) = (given.advanced_to(t1), given);
@@ -606,6 +678,67 @@ mod tests {
         let m = set.motion(&x, &v, &v);
         let power = force.dot(&m.velocity) + torque.dot(&m.angular_velocity);
         assert!((nodal_power - power).abs() < 1e-12 * nodal_power.abs().max(1.0));
+    }
+
+    /// A followed sample's offset (the bend of the path it followed): the frame starts on that
+    /// path, in pose and velocities, and is on the sample's own path from one span on; its
+    /// accelerations are the second derivatives of its pose (central differences).
+    #[test]
+    fn a_frame_sheds_its_offset_over_one_span() {
+        let sample = DrivingFrame {
+            position: Vector3::new(1.0, 2.0, -0.5),
+            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
+            velocity: Vector3::new(0.5, -1.0, 2.0),
+            angular_velocity: Vector3::new(0.0, 0.0, 1.5),
+            acceleration: Vector3::new(3.0, 1.0, -2.0),
+            angular_acceleration: Vector3::new(0.0, 0.0, 2.0),
+            changed_at: 1.0,
+            rate_span: 0.01,
+            updated_at: 1.0,
+            offset: [Vector3::zeros(); 4],
+        };
+        let offset = [
+            Vector3::new(1e-6, -2e-6, 3e-6),
+            Vector3::new(0.0, 0.0, 4e-6),
+            Vector3::new(-3e-4, 1e-4, 2e-4),
+            Vector3::new(0.0, 0.0, -5e-4),
+        ];
+        let shed = DrivingFrame { offset, ..sample };
+        let (p0, q0) = shed.at(1.0);
+        let (v0, w0) = shed.velocities_at(1.0);
+        assert!((p0 - sample.position - offset[0]).amax() < 1e-15);
+        let turn = q0 * sample.rotation.transpose();
+        assert!((crate::body::frame::rotation_vector(&turn) - offset[1]).amax() < 1e-15);
+        assert!((v0 - sample.velocity - offset[2]).amax() < 1e-15);
+        assert!((w0 - sample.angular_velocity - offset[3]).amax() < 1e-15);
+        for t in [1.01, 1.013] {
+            assert_eq!(shed.at(t), sample.at(t));
+            assert_eq!(shed.velocities_at(t), sample.velocities_at(t));
+            assert_eq!(shed.accelerations_at(t), sample.extrapolation_rates());
+        }
+        // Just before the span ends (1e-5 of it) the offset is gone to second order: 3e-10 of
+        // it (1e-15 m) where a linear decay would leave 1e-5 (3e-11 m).
+        let (p1, _) = shed.at(1.01 - 1e-7);
+        assert!((p1 - sample.at(1.01 - 1e-7).0).amax() < 1e-14);
+        let e = 1e-5;
+        for t in [1.002, 1.005, 1.008] {
+            let (pm, pp, pc) = (shed.at(t - e).0, shed.at(t + e).0, shed.at(t).0);
+            let (a, _) = shed.accelerations_at(t);
+            assert!(((pp - 2.0 * pc + pm) / (e * e) - a).amax() < 1e-5 * a.amax());
+            let (vm, vp) = (shed.velocities_at(t - e).0, shed.velocities_at(t + e).0);
+            assert!(((vp - vm) / (2.0 * e) - a).amax() < 1e-6 * a.amax());
+            // About a fixed axis the angular velocity and acceleration are exact.
+            let (wm, wp) = (shed.velocities_at(t - e).1, shed.velocities_at(t + e).1);
+            let (_, alpha) = shed.accelerations_at(t);
+            assert!(((wp - wm) / (2.0 * e) - alpha).amax() < 1e-6 * alpha.amax());
+        }
+        // The offset is the frame's own: as given anew at a time within its span it is on the
+        // same path.
+        let later = shed.advanced_to(1.004);
+        assert_eq!(later.offset, [Vector3::zeros(); 4]);
+        let (pa, qa) = later.at(1.004);
+        let (pb, qb) = shed.at(1.004);
+        assert!((pa - pb).amax() < 1e-15 && (qa - qb).amax() < 1e-15);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! interfaces, the loads of force interfaces, and the inputs as samples in time.
 
 use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
-use crate::body::frame::{angle_between, nearest_rotation, node};
+use crate::body::frame::{angle_between, nearest_rotation, node, rotation_vector};
 use crate::body::interface::DrivingFrame;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
@@ -241,6 +241,17 @@ fn follows_rates(given: &DrivingFrame, new: &DrivingFrame, since: f64, size: f64
     distance(&smooth) < distance(&held)
 }
 
+/// The offset `[δp, δθ, δv, δω]` of the pose and velocities of `path` from `sample`'s
+/// (`DrivingFrame`): the rotation as the rotation vector of `Q_path Q_sampleᵀ`.
+fn offset_from(path: &DrivingFrame, sample: &DrivingFrame) -> [Vector3<f64>; 4] {
+    [
+        path.position - sample.position,
+        rotation_vector(&(path.rotation * sample.rotation.transpose())),
+        path.velocity - sample.velocity,
+        path.angular_velocity - sample.angular_velocity,
+    ]
+}
+
 /// Whether two driving frames differ beyond round-off (`1e-12` of the quantity, plus `1e-12`
 /// absolute).
 fn frames_differ(a: &DrivingFrame, b: &DrivingFrame) -> bool {
@@ -348,7 +359,12 @@ impl Slave {
                         // `O(H²)` in the velocity and `O(H³)` in the pose: no jump, its steps
                         // are estimated like any other (docs/fmu.md, "Inputs are samples in
                         // time").
-                        if !(followed && frame.rate_span > 0.0) {
+                        if followed && frame.rate_span > 0.0 {
+                            // It starts where the path it followed stands, and sheds the
+                            // difference by the next sample (`DrivingFrame`: the bend carried
+                            // off).
+                            frame.offset = offset_from(&old.advanced_to(t), &frame);
+                        } else {
                             jumped = true;
                             motion_jumped = true;
                         }

@@ -11,7 +11,7 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
-//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span, time of the last update) f64: each motion interface's frame as given at its last change (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes, the time between them when the frame follows them (0: not) and when its inputs were last given |
+//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span, time of the last update, offset[12]) f64: each motion interface's frame as given at its last change (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes, the time between them when the frame follows them (0: not), when its inputs were last given, and the offset of its pose and velocities it sheds over the rate span (δp, δθ, δv, δω) |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | stop time | u8 (1: defined), f64 (0 when not) |
@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 14;
+pub const PAYLOAD_FORMAT: u32 = 15;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -208,6 +208,7 @@ impl SlaveState {
             w.f64(f.changed_at);
             w.f64(f.rate_span);
             w.f64(f.updated_at);
+            f.offset.iter().for_each(|o| w.f64s(o.as_slice()));
         }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
@@ -286,7 +287,7 @@ impl Slave {
         r.f64s(&mut input_times, "an input sample time")?;
         let mut driving = vec![DrivingFrame::default(); n];
         for f in &mut driving {
-            let mut v = [0.0; 27];
+            let mut v = [0.0; 39];
             r.f64s(&mut v, "a driving frame")?;
             f.position = Vector3::from_column_slice(&v[0..3]);
             f.rotation = Matrix3::from_row_slice(&v[3..12]);
@@ -297,6 +298,9 @@ impl Slave {
             f.changed_at = v[24];
             f.rate_span = v[25];
             f.updated_at = v[26];
+            for (k, o) in f.offset.iter_mut().enumerate() {
+                *o = Vector3::from_column_slice(&v[27 + 3 * k..30 + 3 * k]);
+            }
         }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;

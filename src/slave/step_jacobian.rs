@@ -6,7 +6,7 @@ use super::interfaces::apply_loads;
 use super::{Inputs, OutputGroup, Slave};
 use crate::body::frame::left_jacobian;
 use crate::body::frame::set_node;
-use crate::body::interface::{DrivingFrame, NodeSet};
+use crate::body::interface::{shedding, DrivingFrame, NodeSet};
 use crate::error::{Error, Result};
 use crate::model::enumerations::{Formulation, Integrator};
 use crate::model::variables::InterfaceQuantity;
@@ -462,14 +462,25 @@ impl Slave {
                     f if f.rate_span > 0.0 => 1.0 / (start - f.changed_at),
                     _ => 0.0,
                 },
+                // A change given at a followed update is carried in over the update's interval,
+                // as the sample's bend is carried off (`DrivingFrame`, the offset): at `start`
+                // itself when the frame changed there following its rates (it has an offset), or
+                // at a new update at `start` when it follows them since an earlier one.
+                match self.driving[interface] {
+                    f if f.rate_span > 0.0 && f.changed_at == start => {
+                        (f.offset != [Vector3::zeros(); 4]).then_some(f.rate_span)
+                    }
+                    f if f.rate_span > 0.0 => Some(start - f.changed_at),
+                    _ => None,
+                },
             )),
             Seed::Load { .. } => None,
         };
         let reference = &body.reference;
         let prescribe = |tau: f64, ds: &mut DynamicState| {
-            if let Some((set, frame, quantity, component, rate)) = driven {
+            if let Some((set, frame, quantity, component, rate, shed)) = driven {
                 let seed = (quantity, component, rate);
-                frame_perturbation(set, reference, &frame, seed, tau, ds);
+                frame_perturbation(set, reference, &frame, seed, shed, tau, ds);
             }
         };
         // The residual's directional derivative at this state, less the seed's load.
@@ -615,11 +626,13 @@ impl Slave {
 /// one unit: `x = p + v τ + a τ²/2 + exp([ω τ + α τ²/2]×) Q d` (`Q d` for a direction)
 /// differentiated, the rates depending on the velocities as `∂a/∂v = ∂α/∂ω = rate` (`seed =
 /// (quantity, component, rate)`; [`DrivingFrame`]).
+#[allow(clippy::too_many_arguments)]
 fn frame_perturbation(
     set: &NodeSet,
     reference: &[f64],
     frame: &DrivingFrame,
     (quantity, component, rate): (InterfaceQuantity, usize, f64),
+    shed: Option<f64>,
     tau: f64,
     ds: &mut DynamicState,
 ) {
@@ -630,17 +643,25 @@ fn frame_perturbation(
     let unit = Vector3::ith(component % 3, 1.0);
     // How far a unit change of a velocity moves the frame: `τ + rate τ²/2`.
     let reach = tau + 0.5 * rate * tau * tau;
+    // What is left at τ of the offset a change at a followed update makes (`DrivingFrame`):
+    // `−(δ h₀₀ + δ̇ Δt h₁₀)` of a change `δ` of the pose or `δ̇` of the velocities.
+    let [left, left_of_rate] = shed
+        .and_then(|span| shedding(tau, span))
+        .map_or([0.0, 0.0], |[h00, h10]| [h00[0], h10[0]]);
     // δ(Q d) = D d, and δp for a point.
     let (rotation_change, point_change) = match quantity {
-        Q::Position => (Matrix3::zeros(), unit),
-        Q::Velocity => (Matrix3::zeros(), reach * unit),
+        Q::Position => (Matrix3::zeros(), (1.0 - left) * unit),
+        Q::Velocity => (Matrix3::zeros(), (reach - left_of_rate) * unit),
         Q::Rotation => {
             let e = Matrix3::from_fn(|r, c| f64::from(u8::from(3 * r + c == component)));
             let a = q.transpose() * e;
-            (turn * q * (0.5 * (a - a.transpose())), Vector3::zeros())
+            // δQ = Q S: the turn `[δθ]× = Q S Qᵀ` of the sample, less what is left of it.
+            let s = 0.5 * (a - a.transpose());
+            let change = turn * q * s - left * (q * s * q.transpose()) * turn * q;
+            (change, Vector3::zeros())
         }
         Q::AngularVelocity => {
-            let w = left_jacobian(&frame.turn(t)) * (reach * unit);
+            let w = left_jacobian(&frame.turn(t)) * (reach * unit) - left_of_rate * unit;
             (w.cross_matrix() * turn * q, Vector3::zeros())
         }
         _ => (Matrix3::zeros(), Vector3::zeros()),
