@@ -437,10 +437,10 @@ fn a_discarded_step_leaves_the_whole_state_as_it_was() {
     let after = bytes(&s);
     // The counters' place (src/slave/state_bytes.rs): format and interface count (8 bytes), the
     // parameters (270), per interface its inputs, derivatives, sample time and driving frame
-    // with its rates, their span, its last update and the offset it sheds (1 040), the last step
+    // with its rates, their span, its last update and the offset it sheds (1 048), the last step
     // size and the start time (16), the stop time (9); four u64 counters.
     let n = 2;
-    let counters = 303 + 1040 * n..303 + 1040 * n + 32;
+    let counters = 303 + 1048 * n..303 + 1048 * n + 32;
     assert_eq!(after.len(), before.len());
     let differ: Vec<usize> = (0..after.len())
         .filter(|&i| after[i] != before[i])

@@ -275,14 +275,24 @@ fn skew_axis(r: &Matrix3<f64>) -> Vector3<f64> {
     )
 }
 
-/// The rotation vector `φ = θ n` of a rotation `R = exp([φ]×)` (θ < π): from the skew part
+/// The rotation vector `φ = θ n` of a rotation `R = exp([φ]×)` (0 ≤ θ ≤ π): from the skew part
 /// `2 sin θ n` and the angle of [`angle_between`], well conditioned at small angles (where it is
-/// the skew part's half).
+/// the skew part's half); near π, where the skew part vanishes, the axis from the symmetric part
+/// `(R + Rᵀ)/2 − cos θ I = (1 − cos θ) n nᵀ` (its largest column), its sign the skew part's.
 pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
     let skew = skew_axis(r);
     let sine = 0.5 * skew.norm();
-    let theta = sine.atan2(0.5 * (r.trace() - 1.0));
-    if sine < 1e-8 {
+    let cosine = 0.5 * (r.trace() - 1.0);
+    let theta = sine.atan2(cosine);
+    if sine < 1e-3 && cosine < 0.0 {
+        let outer = 0.5 * (r + r.transpose()) - Matrix3::identity() * cosine;
+        let k = (0..3)
+            .max_by(|&i, &j| outer[(i, i)].total_cmp(&outer[(j, j)]))
+            .unwrap_or(0);
+        let axis = outer.column(k).normalize();
+        let sign = if axis.dot(&skew) < 0.0 { -1.0 } else { 1.0 };
+        sign * theta * axis
+    } else if sine < 1e-8 {
         0.5 * skew
     } else {
         skew * (0.5 * theta / sine)
@@ -312,6 +322,7 @@ pub fn left_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
 mod tests {
     use super::*;
     use nalgebra::Rotation3;
+    use std::f64::consts::PI;
 
     #[test]
     fn the_angle_between_two_rotations_is_that_of_their_turn() {
@@ -325,6 +336,26 @@ mod tests {
                 "{found} for {theta}"
             );
         }
+    }
+
+    #[test]
+    fn the_rotation_vector_inverts_the_exponential_from_0_to_pi() {
+        let axis = Vector3::new(0.3, -0.8, 0.5).normalize();
+        for theta in [0.0, 1e-12, 1e-7, 1e-3, 0.7, 2.0, 3.0, PI - 1e-5, PI - 1e-9] {
+            let phi = theta * axis;
+            let r = *Rotation3::from_scaled_axis(phi).matrix();
+            let back = rotation_vector(&r);
+            assert!(
+                (back - phi).amax() < 1e-9,
+                "θ = {theta}: {back} against {phi}"
+            );
+        }
+        // At π the two signs are the same rotation.
+        let r = *Rotation3::from_scaled_axis(PI * axis).matrix();
+        let back = rotation_vector(&r);
+        assert!(
+            (back.norm() - PI).abs() < 1e-12 && back.normalize().dot(&axis).abs() > 1.0 - 1e-12
+        );
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! interfaces, the loads of force interfaces, and the inputs as samples in time.
 
 use super::{InputDerivatives, Inputs, Slave, INTERFACE_SLOTS};
-use crate::body::frame::{angle_between, nearest_rotation, node, rotation_vector};
+use crate::body::frame::{angle_between, left_jacobian, nearest_rotation, node, rotation_vector};
 use crate::body::interface::DrivingFrame;
 use crate::body::{Body, NodeSet};
 use crate::error::{Error, Result};
@@ -242,13 +242,21 @@ fn follows_rates(given: &DrivingFrame, new: &DrivingFrame, since: f64, size: f64
 }
 
 /// The offset `[δp, δθ, δv, δω]` of the pose and velocities of `path` from `sample`'s
-/// (`DrivingFrame`): the rotation as the rotation vector of `Q_path Q_sampleᵀ`.
+/// (`DrivingFrame`): the rotation as the rotation vector of `Q_path Q_sampleᵀ`, and `δω` such
+/// that `J_l(δθ) δω + exp([δθ]×) ω_sample = ω_path`, the angular velocity of
+/// `exp([δθ]×) Q_sample` turning with both.
 fn offset_from(path: &DrivingFrame, sample: &DrivingFrame) -> [Vector3<f64>; 4] {
+    let turn = path.rotation * sample.rotation.transpose();
+    let theta = rotation_vector(&turn);
+    let rest = path.angular_velocity - turn * sample.angular_velocity;
+    let omega = left_jacobian(&theta)
+        .try_inverse()
+        .map_or(rest, |inverse| inverse * rest);
     [
         path.position - sample.position,
-        rotation_vector(&(path.rotation * sample.rotation.transpose())),
+        theta,
         path.velocity - sample.velocity,
-        path.angular_velocity - sample.angular_velocity,
+        omega,
     ]
 }
 
@@ -364,6 +372,7 @@ impl Slave {
                             // difference by the next sample (`DrivingFrame`: the bend carried
                             // off).
                             frame.offset = offset_from(&old.advanced_to(t), &frame);
+                            frame.sheds = true;
                         } else {
                             jumped = true;
                             motion_jumped = true;

@@ -11,7 +11,7 @@
 //! | inputs | `n × 30` f64 (value-reference slot order) |
 //! | input derivatives | `n × 2 × 30` f64 (order 1, then order 2) |
 //! | input sample times | `n` f64 (the time each interface's inputs describe) |
-//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span, time of the last update, offset[12]) f64: each motion interface's frame as given at its last change (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes, the time between them when the frame follows them (0: not), when its inputs were last given, and the offset of its pose and velocities it sheds over the rate span (δp, δθ, δv, δω) |
+//! | driving frames | `n ×` (position[3], rotation[9] row-major, velocity[3], angular velocity[3], acceleration[3], angular acceleration[3], time of the last change, rate span, time of the last update, offset[12], whether it sheds it (1) or not (0)) f64: each motion interface's frame as given at its last change (zeros and the identity for other interfaces), with its velocities' mean rates between their last two changes, the time between them when the frame follows them (0: not), when its inputs were last given, and the offset of its pose and velocities it sheds over the rate span (δp, δθ, δv, δω) where it sheds one |
 //! | last step size | f64 (0 before the first step) |
 //! | start time | f64 |
 //! | stop time | u8 (1: defined), f64 (0 when not) |
@@ -209,6 +209,7 @@ impl SlaveState {
             w.f64(f.rate_span);
             w.f64(f.updated_at);
             f.offset.iter().for_each(|o| w.f64s(o.as_slice()));
+            w.f64(if f.sheds { 1.0 } else { 0.0 });
         }
         w.f64(self.last_step_size);
         w.f64(self.start_time);
@@ -287,7 +288,7 @@ impl Slave {
         r.f64s(&mut input_times, "an input sample time")?;
         let mut driving = vec![DrivingFrame::default(); n];
         for f in &mut driving {
-            let mut v = [0.0; 39];
+            let mut v = [0.0; 40];
             r.f64s(&mut v, "a driving frame")?;
             f.position = Vector3::from_column_slice(&v[0..3]);
             f.rotation = Matrix3::from_row_slice(&v[3..12]);
@@ -301,6 +302,7 @@ impl Slave {
             for (k, o) in f.offset.iter_mut().enumerate() {
                 *o = Vector3::from_column_slice(&v[27 + 3 * k..30 + 3 * k]);
             }
+            f.sheds = v[39] != 0.0;
         }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;

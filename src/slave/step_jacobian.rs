@@ -464,11 +464,11 @@ impl Slave {
                 },
                 // A change given at a followed update is carried in over the update's interval,
                 // as the sample's bend is carried off (`DrivingFrame`, the offset): at `start`
-                // itself when the frame changed there following its rates (it has an offset), or
+                // itself when the frame changed there following its rates (it sheds), or
                 // at a new update at `start` when it follows them since an earlier one.
                 match self.driving[interface] {
                     f if f.rate_span > 0.0 && f.changed_at == start => {
-                        (f.offset != [Vector3::zeros(); 4]).then_some(f.rate_span)
+                        f.sheds.then_some(f.rate_span)
                     }
                     f if f.rate_span > 0.0 => Some(start - f.changed_at),
                     _ => None,
@@ -625,7 +625,9 @@ impl Slave {
 /// driving frame `frame` (at the step's start) has its input `quantity[component]` changed by
 /// one unit: `x = p + v τ + a τ²/2 + exp([ω τ + α τ²/2]×) Q d` (`Q d` for a direction)
 /// differentiated, the rates depending on the velocities as `∂a/∂v = ∂α/∂ω = rate` (`seed =
-/// (quantity, component, rate)`; [`DrivingFrame`]).
+/// (quantity, component, rate)`; [`DrivingFrame`]); with `shed = Some(Δt)` the change comes at
+/// an update the frame follows through and is carried in over `Δt` as its offset is carried off
+/// ([`shedding`]: what is left of it at `τ` taken away).
 #[allow(clippy::too_many_arguments)]
 fn frame_perturbation(
     set: &NodeSet,
