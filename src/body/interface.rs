@@ -618,25 +618,30 @@ fn polar_inertia(fw: &FrameWeights, x: &[f64], c: &Vector3<f64>) -> Matrix3<f64>
 mod tests {
     use super::*;
 
+    /// A frame given at `t = 1` s that follows its rates over 10 ms, with angular velocity `omega`
+    /// and angular acceleration `alpha`.
+    fn followed_at_one(omega: Vector3<f64>, alpha: Vector3<f64>) -> DrivingFrame {
+        DrivingFrame {
+            position: Vector3::new(1.0, 2.0, -0.5),
+            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
+            velocity: Vector3::new(0.5, -1.0, 2.0),
+            angular_velocity: omega,
+            acceleration: Vector3::new(3.0, 1.0, -2.0),
+            angular_acceleration: alpha,
+            changed_at: 1.0,
+            rate_span: 0.01,
+            updated_at: 1.0,
+            ..DrivingFrame::default()
+        }
+    }
+
     /// A frame following its rates is one path measured from its inputs: advanced to `t₁` it
     /// stands where the path is at `t₁`, its origin is `p + v τ + a τ²/2` and its angular
     /// velocity the derivative of its rotation (`ω` and `α` on different axes); without a span
     /// it keeps constant velocities.
     #[test]
     fn a_frame_following_its_rates_is_one_path() {
-        let given = DrivingFrame {
-            position: Vector3::new(1.0, 2.0, -0.5),
-            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
-            velocity: Vector3::new(0.5, -1.0, 2.0),
-            angular_velocity: Vector3::new(0.3, 1.5, -0.2),
-            acceleration: Vector3::new(3.0, 1.0, -2.0),
-            angular_acceleration: Vector3::new(-4.0, 0.5, 2.0),
-            changed_at: 1.0,
-            rate_span: 0.01,
-            updated_at: 1.0,
-            offset: [Vector3::zeros(); 4],
-            sheds: false,
-        };
+        let given = followed_at_one(Vector3::new(0.3, 1.5, -0.2), Vector3::new(-4.0, 0.5, 2.0));
         let (t1, t2) = (1.013, 1.034);
         let (a, b) = (given.advanced_to(t1), given);
         let (pa, qa) = a.at(t1);
@@ -722,19 +727,7 @@ mod tests {
     /// accelerations are the second derivatives of its pose (central differences).
     #[test]
     fn a_frame_sheds_its_offset_over_one_span() {
-        let sample = DrivingFrame {
-            position: Vector3::new(1.0, 2.0, -0.5),
-            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.1, -0.4)).matrix(),
-            velocity: Vector3::new(0.5, -1.0, 2.0),
-            angular_velocity: Vector3::new(0.0, 0.0, 1.5),
-            acceleration: Vector3::new(3.0, 1.0, -2.0),
-            angular_acceleration: Vector3::new(0.0, 0.0, 2.0),
-            changed_at: 1.0,
-            rate_span: 0.01,
-            updated_at: 1.0,
-            offset: [Vector3::zeros(); 4],
-            sheds: false,
-        };
+        let sample = followed_at_one(Vector3::new(0.0, 0.0, 1.5), Vector3::new(0.0, 0.0, 2.0));
         let offset = [
             Vector3::new(1e-6, -2e-6, 3e-6),
             Vector3::new(0.0, 0.0, 4e-6),
