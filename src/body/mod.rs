@@ -2,6 +2,7 @@
 //! stiffness `K`, the co-moving frame, the local deformation `ū`, the internal force with the
 //! nonlinear term `f_nl`, Rayleigh damping of the deformation, and the node sets of interfaces.
 
+pub mod driving_frame;
 pub mod feature_indicators;
 pub mod frame;
 pub mod interface;
