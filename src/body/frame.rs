@@ -340,16 +340,25 @@ mod tests {
 
     #[test]
     fn the_rotation_vector_inverts_the_exponential_from_0_to_pi() {
-        let axis = Vector3::new(0.3, -0.8, 0.5).normalize();
-        for theta in [0.0, 1e-12, 1e-7, 1e-3, 0.7, 2.0, 3.0, PI - 1e-5, PI - 1e-9] {
-            let phi = theta * axis;
-            let r = *Rotation3::from_scaled_axis(phi).matrix();
-            let back = rotation_vector(&r);
-            assert!(
-                (back - phi).amax() < 1e-9,
-                "θ = {theta}: {back} against {phi}"
-            );
+        // Both signs of the dominant component, and angles on both sides of the branch near π
+        // (`sin θ = 1e-3`).
+        for axis in [Vector3::new(0.3, -0.8, 0.5), Vector3::new(0.9, 0.2, -0.4)] {
+            let axis = axis.normalize();
+            let near_pi = [PI - 1.0001e-3, PI - 0.9999e-3, PI - 1e-5, PI - 1e-9];
+            for theta in [0.0, 1e-12, 1e-7, 1e-3, 0.7, 2.0, 3.0]
+                .into_iter()
+                .chain(near_pi)
+            {
+                let phi = theta * axis;
+                let r = *Rotation3::from_scaled_axis(phi).matrix();
+                let back = rotation_vector(&r);
+                assert!(
+                    (back - phi).amax() < 1e-12,
+                    "θ = {theta}: {back} against {phi}"
+                );
+            }
         }
+        let axis = Vector3::new(0.3, -0.8, 0.5).normalize();
         // At π the two signs are the same rotation.
         let r = *Rotation3::from_scaled_axis(PI * axis).matrix();
         let back = rotation_vector(&r);

@@ -618,3 +618,53 @@ pub(super) fn default_inputs(interfaces: &[Interface]) -> Vec<Inputs> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The offset a followed update takes puts the frame where the path it followed stands, in
+    /// pose and velocities, for turns about different axes (the path's `ω`, `α` and the
+    /// sample's off `δθ`'s axis).
+    #[test]
+    fn a_followed_update_starts_where_the_path_stands() {
+        let path = DrivingFrame {
+            position: Vector3::new(0.1, -0.2, 0.3),
+            rotation: *nalgebra::Rotation3::from_scaled_axis(Vector3::new(0.2, 0.5, -0.1)).matrix(),
+            velocity: Vector3::new(1.0, 0.5, -0.3),
+            angular_velocity: Vector3::new(0.4, 1.5, -0.7),
+            acceleration: Vector3::new(2.0, -1.0, 0.5),
+            angular_acceleration: Vector3::new(-3.0, 1.0, 2.0),
+            changed_at: 1.0,
+            rate_span: 0.01,
+            updated_at: 1.0,
+            ..DrivingFrame::default()
+        };
+        let t = 1.01;
+        let carried = path.advanced_to(t);
+        let turn = nalgebra::Rotation3::from_scaled_axis(Vector3::new(3e-3, -2e-3, 1e-3));
+        let sample = DrivingFrame {
+            position: carried.position + Vector3::new(1e-4, -2e-4, 3e-4),
+            rotation: turn.matrix() * carried.rotation,
+            velocity: carried.velocity + Vector3::new(-2e-2, 1e-2, 3e-2),
+            angular_velocity: carried.angular_velocity + Vector3::new(0.05, -0.03, 0.02),
+            changed_at: t,
+            updated_at: t,
+            ..path
+        };
+        let shed = DrivingFrame {
+            offset: offset_from(&carried, &sample),
+            sheds: true,
+            ..sample
+        };
+        let ((p, q), (v, w)) = (shed.at(t), shed.velocities_at(t));
+        assert!((p - carried.position).amax() < 1e-15);
+        assert!((q - carried.rotation).amax() < 1e-15);
+        assert!((v - carried.velocity).amax() < 1e-15);
+        assert!(
+            (w - carried.angular_velocity).amax() < 1e-14,
+            "{w} {}",
+            carried.angular_velocity
+        );
+    }
+}

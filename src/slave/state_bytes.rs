@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 15;
+pub const PAYLOAD_FORMAT: u32 = 16;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -302,7 +302,15 @@ impl Slave {
             for (k, o) in f.offset.iter_mut().enumerate() {
                 *o = Vector3::from_column_slice(&v[27 + 3 * k..30 + 3 * k]);
             }
-            f.sheds = v[39] != 0.0;
+            f.sheds = match v[39] {
+                0.0 => false,
+                1.0 => true,
+                other => {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state has {other} for whether a driving frame sheds its offset, which is 0 or 1"
+                    )))
+                }
+            };
         }
         let last_step_size = r.f64("the last step size")?;
         let start_time = r.f64("the start time")?;
