@@ -99,11 +99,12 @@ impl DrivingFrame {
         let tau = t - self.changed_at;
         let (a, _) = self.extrapolation_rates();
         let turn = nalgebra::Rotation3::from_scaled_axis(self.turn(t));
-        let [(c_p, _, _), (c_theta, _, _)] = self.shed_offset(t);
-        (
-            self.position + self.velocity * tau + a * (0.5 * tau * tau) + c_p,
-            rotation_of(&c_theta) * turn.matrix() * self.rotation,
-        )
+        let position = self.position + self.velocity * tau + a * (0.5 * tau * tau);
+        let rotation = turn.matrix() * self.rotation;
+        match self.shed_offset(t) {
+            None => (position, rotation),
+            Some([(c_p, _, _), (c, _, _)]) => (position + c_p, rotation_of(&c) * rotation),
+        }
     }
 
     /// Velocity and angular velocity at `t`: `v + a τ` and `J_l(φ) (ω + α τ)`, with what is left
@@ -111,16 +112,19 @@ impl DrivingFrame {
     pub fn velocities_at(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let tau = t - self.changed_at;
         let (a, alpha) = self.extrapolation_rates();
+        let velocity = self.velocity + a * tau;
         let angular = if self.rate_span > 0.0 {
             left_jacobian(&self.turn(t)) * (self.angular_velocity + alpha * tau)
         } else {
             self.angular_velocity
         };
-        let [(_, dc_p, _), (c, dc, _)] = self.shed_offset(t);
-        (
-            self.velocity + a * tau + dc_p,
-            left_jacobian(&c) * dc + rotation_of(&c) * angular,
-        )
+        match self.shed_offset(t) {
+            None => (velocity, angular),
+            Some([(_, dc_p, _), (c, dc, _)]) => (
+                velocity + dc_p,
+                left_jacobian(&c) * dc + rotation_of(&c) * angular,
+            ),
+        }
     }
 
     /// Acceleration and angular acceleration of the path at `t`: the rates the frame follows
@@ -129,10 +133,9 @@ impl DrivingFrame {
     /// (without `J̇_l ċ`, third order in the offset: its first-order part `½ ċ × ċ` vanishes).
     pub fn accelerations_at(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
         let (a, alpha) = self.extrapolation_rates();
-        let [(_, _, ddc_p), (c, dc, ddc)] = self.shed_offset(t);
-        if c == Vector3::zeros() && dc == Vector3::zeros() && ddc == Vector3::zeros() {
-            return (a + ddc_p, alpha);
-        }
+        let Some([(_, _, ddc_p), (c, dc, ddc)]) = self.shed_offset(t) else {
+            return (a, alpha);
+        };
         let omega = DrivingFrame {
             sheds: false,
             ..*self
@@ -147,17 +150,14 @@ impl DrivingFrame {
     }
 
     /// What is left at `t` of the offset, and its first and second time derivatives, for the
-    /// position and the rotation: `c(τ) = δ h₀₀(u) + δ̇ Δt h₁₀(u)`, `u = τ/Δt` (zero outside
-    /// `0 ≤ τ < Δt = rate_span`; the struct's documentation).
-    fn shed_offset(&self, t: f64) -> [(Vector3<f64>, Vector3<f64>, Vector3<f64>); 2] {
-        let zero = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-        let shedding = self
-            .sheds
-            .then(|| shedding(t - self.changed_at, self.rate_span))
-            .flatten();
-        let Some([h00, h10]) = shedding else {
-            return [zero; 2];
-        };
+    /// position and the rotation: `c(τ) = δ h₀₀(u) + δ̇ Δt h₁₀(u)`, `u = τ/Δt` (the struct's
+    /// documentation). `None` where the frame does not shed or has shed it all (outside
+    /// `0 ≤ τ < Δt = rate_span`).
+    fn shed_offset(&self, t: f64) -> Option<[LeftOfOffset; 2]> {
+        if !self.sheds {
+            return None;
+        }
+        let [h00, h10] = shedding(t - self.changed_at, self.rate_span)?;
         let [dp, dtheta, dv, domega] = self.offset;
         let shed = |d: Vector3<f64>, e: Vector3<f64>| {
             (
@@ -166,7 +166,7 @@ impl DrivingFrame {
                 d * h00[2] + e * h10[2],
             )
         };
-        [shed(dp, dv), shed(dtheta, domega)]
+        Some([shed(dp, dv), shed(dtheta, domega)])
     }
 
     /// The frame as it stands at `t`, given anew there: pose and velocities at `t` (the offset's
@@ -187,6 +187,10 @@ impl DrivingFrame {
         }
     }
 }
+
+/// What is left of an offset at a time, with its first and second time derivatives (m, m/s,
+/// m/s² for the position; rad, rad/s, rad/s² for the rotation).
+type LeftOfOffset = (Vector3<f64>, Vector3<f64>, Vector3<f64>);
 
 /// `exp([φ]×)`.
 fn rotation_of(phi: &Vector3<f64>) -> Matrix3<f64> {
