@@ -449,38 +449,34 @@ impl Slave {
                 interface,
                 quantity,
                 component,
-            } => Some((
-                &self.interfaces[interface].set,
-                self.driving[interface].advanced_to(start),
-                quantity,
-                component,
-                // The rates the frame follows come from the velocities given at `start`
-                // (`DrivingFrame`): `a = (v − v_given) / Δt`, `∂a/∂v = 1 / Δt`, `Δt` back to the
-                // change before (this step's own when it changed at `start`).
-                match self.driving[interface] {
-                    f if f.rate_span > 0.0 && f.changed_at == start => 1.0 / f.rate_span,
-                    f if f.rate_span > 0.0 => 1.0 / (start - f.changed_at),
-                    _ => 0.0,
-                },
-                // A change given at a followed update is carried in over the update's interval,
-                // as the sample's bend is carried off (`DrivingFrame`, the offset): at `start`
-                // itself when the frame changed there following its rates (it sheds), or
-                // at a new update at `start` when it follows them since an earlier one.
-                match self.driving[interface] {
-                    f if f.rate_span > 0.0 && f.changed_at == start => {
-                        f.sheds.then_some(f.rate_span)
-                    }
-                    f if f.rate_span > 0.0 => Some(start - f.changed_at),
-                    _ => None,
-                },
-            )),
+            } => {
+                // Where the frame follows rates, `Δt` back to the change before (this step's own
+                // when it changed at `start`): the rates come from the velocities given at
+                // `start` (`DrivingFrame`), `a = (v − v_given) / Δt`, `∂a/∂v = 1 / Δt`; and a
+                // change given at a followed update is carried in over `Δt`, as the sample's
+                // bend is carried off (`DrivingFrame`, the offset): at `start` itself when the
+                // frame changed there following its rates (it sheds), or at a new update at
+                // `start` when it follows them since an earlier one.
+                let f = self.driving[interface];
+                let span = (f.rate_span > 0.0).then_some(if f.changed_at == start {
+                    f.rate_span
+                } else {
+                    start - f.changed_at
+                });
+                let rate = span.map_or(0.0, f64::recip);
+                let shed = span.filter(|_| f.changed_at != start || f.sheds);
+                Some((
+                    &self.interfaces[interface].set,
+                    f.advanced_to(start),
+                    (quantity, component, rate, shed),
+                ))
+            }
             Seed::Load { .. } => None,
         };
         let reference = &body.reference;
         let prescribe = |tau: f64, ds: &mut DynamicState| {
-            if let Some((set, frame, quantity, component, rate, shed)) = driven {
-                let seed = (quantity, component, rate);
-                frame_perturbation(set, reference, &frame, seed, shed, tau, ds);
+            if let Some((set, frame, seed)) = driven {
+                frame_perturbation(set, reference, &frame, seed, tau, ds);
             }
         };
         // The residual's directional derivative at this state, less the seed's load.
@@ -625,16 +621,14 @@ impl Slave {
 /// driving frame `frame` (at the step's start) has its input `quantity[component]` changed by
 /// one unit: `x = p + v τ + a τ²/2 + exp([ω τ + α τ²/2]×) Q d` (`Q d` for a direction)
 /// differentiated, the rates depending on the velocities as `∂a/∂v = ∂α/∂ω = rate` (`seed =
-/// (quantity, component, rate)`; [`DrivingFrame`]); with `shed = Some(Δt)` the change comes at
-/// an update the frame follows through and is carried in over `Δt` as its offset is carried off
-/// ([`shedding`]: what is left of it at `τ` taken away).
-#[allow(clippy::too_many_arguments)]
+/// (quantity, component, rate, shed)`; [`DrivingFrame`]); with `shed = Some(Δt)` the change
+/// comes at an update the frame follows through and is carried in over `Δt` as its offset is
+/// carried off ([`shedding`]: what is left of it at `τ` taken away).
 fn frame_perturbation(
     set: &NodeSet,
     reference: &[f64],
     frame: &DrivingFrame,
-    (quantity, component, rate): (InterfaceQuantity, usize, f64),
-    shed: Option<f64>,
+    (quantity, component, rate, shed): (InterfaceQuantity, usize, f64, Option<f64>),
     tau: f64,
     ds: &mut DynamicState,
 ) {
