@@ -8,9 +8,10 @@
 //!   t = 0, no damping, ρ∞ = 0.9, 0.1 s, communication step 2 ms, `solver.stepSize` 2 ms (the top
 //!   of the ladder). Error: the largest |Δ tip y| over the communication points against the fixed
 //!   step h = 2 ms / 2048 (converged: its own error is 1.5e-6 of the peak), divided by the peak
-//!   |tip y|. The fixed steps `2 ms / 2^k`, k = 0…8, are the hand-chosen settings; "cheapest fixed" is the fastest of them whose error is at most the
-//!   controlled run's, and "interpolated" the time a fixed step of exactly that error would take
-//!   (error ∝ h² and time ∝ 1/h between the two neighbouring rows). Wall times: median of 3.
+//!   |tip y|. The fixed steps `2 ms / 2^k`, k = 0…8, are the hand-chosen settings; "cheapest
+//!   fixed" is the fastest of them whose error is at most the controlled run's, and
+//!   "interpolated" the time a fixed step of exactly that error would take (error ∝ h² and time
+//!   ∝ 1/h between the two neighbouring rows). Wall times: median of 3.
 //! * **B3**: `examples/hub_beam.json` spun up by the hub schedule for 20 s, communication step
 //!   10 ms, `solver.stepSize` 10 ms; error: the largest |Δ tip deflection| in the hub frame
 //!   against `full` converged in time (Richardson's extrapolation of `full` at h = 2.5 ms and
