@@ -256,11 +256,11 @@ fn main() {
 fn b1_section(quick: bool) {
     let repeats = if quick { 1 } else { 3 };
     let end = if quick { 0.04 } else { 0.1 };
-    // The reference's own error must be well below the finest accuracy asked: the fixed 5 µs
-    // step of earlier runs is 4.7e-5 of the peak from the fixed 2 ms / 2048 (its error at
-    // 7.8 µs, 9.7e-5, read 8.2e-5 against it), too close to `1e-4` to judge that row.
-    let h_ref = if quick { 2e-5 } else { 2e-3 / 2048.0 };
     let top = 2e-3;
+    // The reference's own error must be well below the finest accuracy asked: the fixed 5 µs
+    // step of earlier runs is 4.7e-5 of the peak from the fixed `top / 2048` (its error at
+    // 7.8 µs, 9.7e-5, read 8.2e-5 against it), too close to `1e-4` to judge that row.
+    let h_ref = if quick { 2e-5 } else { top / 2048.0 };
     let reference = b1(&[("solver.stepSize", h_ref), ("model.accuracy", 0.0)], end).samples;
     println!(
         "B1: 10 N step load, {end} s, communication step 2 ms, solver.stepSize {top} s; reference: fixed step {h_ref:e} s\n"
