@@ -53,6 +53,9 @@ pub struct LowestModes {
     decay_rates: [f64; MODES + 1],
     /// The body's mass `m` (kg).
     total_mass: f64,
+    /// On a body without supports, `M` of the free elastic nodes (`3n × 3n`, in the order of
+    /// `nodes`), for the RMS of `ū` itself ([`Self::free_body_rms`]); `None` otherwise.
+    free_body_mass: Option<SymmetricCsr>,
 }
 
 impl LowestModes {
@@ -105,7 +108,32 @@ impl LowestModes {
             omega_top_sq,
             decay_rates,
             total_mass,
+            free_body_mass: None,
         }
+    }
+
+    /// The same on a body without supports, whose local deformation `ū` is measured from the
+    /// best-fit frame, the nearest rigid motion: its mass-weighted RMS is then the elastic
+    /// displacement itself ([`Self::free_body_rms`]). `mass`: `M ⊗ I3` of `nodes`, as for
+    /// [`Self::new`].
+    pub fn with_free_body_mass(mut self, mass: SymmetricCsr) -> LowestModes {
+        self.free_body_mass = Some(mass);
+        self
+    }
+
+    /// On a body without supports ([`Self::with_free_body_mass`]), the mass-weighted RMS of the
+    /// local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
+    /// elastic nodes; `None` on a supported body. No allocation.
+    pub fn free_body_rms(&self, ubar: &[f64]) -> Option<f64> {
+        let mass = self.free_body_mass.as_ref()?;
+        let at = |dof: usize| ubar[3 * self.nodes[dof / 3] + dof % 3];
+        let mut squared = 0.0;
+        for row in 0..mass.n {
+            let (cols, values) = mass.row(row);
+            let m_u: f64 = cols.iter().zip(values).map(|(&c, v)| v * at(c)).sum();
+            squared += at(row) * m_u;
+        }
+        Some((squared.max(0.0) / self.total_mass).sqrt())
     }
 
     /// The same with `K φ_j` stored (`product(x, K x)` on the body's `size = 3N` coordinates:
@@ -321,6 +349,18 @@ mod tests {
             iterations: 1,
         };
         LowestModes::new(&[0, 1], &mass, &pairs, 0, 2.0, damping)
+    }
+
+    #[test]
+    fn a_body_without_supports_measures_its_deformation_by_the_rms_of_its_local_field() {
+        let modes = two_oscillators((0.0, 0.0));
+        // Supported: no such measure.
+        assert!(modes.free_body_rms(&[1.0; 6]).is_none());
+        // Unit masses, body mass 2 kg: √((1² + 2² + 3²) / 2) from both nodes' components.
+        let identity: Vec<_> = (0..6).map(|i| (i, i, 1.0)).collect();
+        let free = modes.with_free_body_mass(SymmetricCsr::from_triplets(6, &identity));
+        let rms = free.free_body_rms(&[1.0, 0.0, 2.0, 0.0, 3.0, 0.0]).unwrap();
+        assert!((rms - 7f64.sqrt()).abs() < 1e-15, "{rms}");
     }
 
     #[test]

@@ -139,6 +139,7 @@ impl Slave {
             estimate_floor: 0.0,
             slab_stiffening_ratio: 0.0,
             slab_stiffening_since: None,
+            scale_settling: super::step_control::ScaleSettling::at(self.start_time),
         });
         if let Some(horizon) = self.error_horizon() {
             let over = match self.run_length() {

@@ -93,6 +93,9 @@ struct Dynamics {
     /// When `model.auto` switched the slabs' own stiffening on (s; `None` where it was forced
     /// on or is off): it comes in over the lowest period from then (`SlabStiffeningSwitch::scale`).
     slab_stiffening_since: Option<f64>,
+    /// Whether `D` has settled, so that the iteration's tolerance may follow the allowance
+    /// before the first period has passed ([`step_control::ScaleSettling`]).
+    scale_settling: step_control::ScaleSettling,
 }
 
 /// A snapshot of everything that determines later steps (time, positions, velocities,
@@ -610,6 +613,7 @@ impl Slave {
                 d.estimate_floor = s.estimate_floor;
                 d.slab_stiffening_ratio = s.slab_stiffening_ratio;
                 d.slab_stiffening_since = s.slab_stiffening_since;
+                d.scale_settling = s.scale_settling;
             }
             (d, s) => *d = s.clone(),
         }

@@ -17,7 +17,7 @@
 //! | stop time | u8 (1: defined), f64 (0 when not) |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the slabs' stiffening ratio last measured f64; whether `model.auto` switched the slabs' own stiffening on: u8; when: f64 (0 when not); the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the slabs' stiffening ratio last measured f64; whether `model.auto` switched the slabs' own stiffening on: u8; when: f64 (0 when not); since when the deformation scale has not grown by 10 % f64, the scale then f64, whether it has settled u8; the last internal step's length f64 (0: none) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 16;
+pub const PAYLOAD_FORMAT: u32 = 17;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -250,6 +250,9 @@ impl SlaveState {
                 w.f64(d.slab_stiffening_ratio);
                 w.u8(u8::from(d.slab_stiffening_since.is_some()));
                 w.f64(d.slab_stiffening_since.unwrap_or(0.0));
+                w.f64(d.scale_settling.since);
+                w.f64(d.scale_settling.scale);
+                w.u8(u8::from(d.scale_settling.settled));
                 w.f64(s.step_size);
             }
         }
@@ -500,11 +503,23 @@ impl Slave {
                     )));
                 }
                 let slab_stiffening_since = ramped.then_some(since);
+                let settling_since = r.f64("since when the deformation scale has not grown")?;
+                if settling_since > time {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state has the deformation scale unchanged since t = {settling_since}, after its time {time}"
+                    )));
+                }
+                let settling_scale = r.f64("the deformation scale the settling is counted from")?;
+                let settled = r.boolean("whether the deformation scale has settled")?;
                 for (scale, name) in [
                     (slab_stiffening_ratio, "slabs' stiffening ratio"),
                     (estimate_floor, "estimate floor"),
                     (deformation_scale, "deformation scale"),
                     (high_mode_scale, "scale of the modes above the lowest"),
+                    (
+                        settling_scale,
+                        "deformation scale the settling is counted from",
+                    ),
                 ] {
                     if scale < 0.0 {
                         return Err(Error::new(format!(
@@ -546,6 +561,11 @@ impl Slave {
                     estimate_floor,
                     slab_stiffening_ratio,
                     slab_stiffening_since,
+                    scale_settling: super::step_control::ScaleSettling {
+                        since: settling_since,
+                        scale: settling_scale,
+                        settled,
+                    },
                 })
             }
             b => {

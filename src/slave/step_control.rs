@@ -70,8 +70,97 @@ pub const FOLLOW_ABOVE: f64 = 1e3;
 /// so that the rung it came from is judged within its allowance.
 pub const NOISE_MARGIN: f64 = 4.0;
 
-/// Finest rung: `solver.stepSize / 2^MAX_LEVEL`.
-pub const MAX_LEVEL: u32 = 8;
+/// Finest rung: `solver.stepSize / 2^MAX_LEVEL`. Ten rungs: B2 (an undamped free body over a
+/// run of 3.3 `T₁`) meets `1e-4` on steps of `solver.stepSize / 2^9` (docs/benchmarks.md); with
+/// eight, its steps stayed on the finest rung and it ended 6.3e-4 of its peak off.
+pub const MAX_LEVEL: u32 = 10;
+
+/// Finest rung while the deformation scale is not yet established (neither settled nor a first
+/// period old: [`finest_level`]). A scale still growing from 0 at a load's onset sets an
+/// allowance far below what the run's errors will be judged against, and the two finest rungs
+/// bought nothing there: the connecting rod's onset at `1e-3` went down to `2^9` and took
+/// 1 566 internal steps where `2^8` takes 799, for the same error (docs/benchmarks.md).
+pub const EARLY_MAX_LEVEL: u32 = 8;
+
+/// The finest rung the ladder may refine to: [`MAX_LEVEL`] once the deformation scale is
+/// `established`, [`EARLY_MAX_LEVEL`] before.
+pub fn finest_level(established: bool) -> u32 {
+    if established {
+        MAX_LEVEL
+    } else {
+        EARLY_MAX_LEVEL
+    }
+}
+
+/// The lowest relative tolerance (× size) the iteration's tolerance follows the allowance down
+/// to (docs/formulation.md, "The iteration's tolerance"). Below the round-off of a residual in
+/// absolute coordinates (`TOLERANCE_FLOOR`, 1e-13) a correction can still be resolved on the
+/// finest rungs, where the mass term dominates the iteration matrix: B2 at `1e-4` needs 1e-15.
+pub const FOLLOWING_TOLERANCE_FLOOR: f64 = 1e-15;
+
+/// The deformation scale has settled when it has not grown by this factor for
+/// [`SETTLED_FOR`] of the lowest period (docs/formulation.md, "The iteration's tolerance").
+pub const SETTLED_GROWTH: f64 = 1.1;
+
+/// See [`SETTLED_GROWTH`]: a sixteenth of `T₁`. B2's scale reaches its level within 0.03 s
+/// (`T₁` = 0.30 s) and its tolerance must follow from 0.05 s; B3's grows by 10 % in 0.1 s
+/// (`T₁/16`) through its spin-up.
+pub const SETTLED_FOR: f64 = 1.0 / 16.0;
+
+/// Whether the deformation scale `D` has settled (docs/formulation.md, "The iteration's
+/// tolerance"): it has not grown by [`SETTLED_GROWTH`] for [`SETTLED_FOR`] of the lowest period
+/// `T₁`, counted only while `ε D` is above the iteration's resolution. Once settled it stays
+/// settled, and the iteration's tolerance may follow the allowance before the first period
+/// has passed: errors committed then are judged against the scale of the run, not of a body
+/// still deforming.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScaleSettling {
+    /// When `D` last grew by [`SETTLED_GROWTH`] (or was below the iteration's resolution), s.
+    pub since: f64,
+    /// `D` then (m).
+    pub scale: f64,
+    /// Whether it has settled.
+    pub settled: bool,
+}
+
+impl ScaleSettling {
+    /// At the start of a run at `time` (s).
+    pub fn at(time: f64) -> ScaleSettling {
+        ScaleSettling {
+            since: time,
+            scale: 0.0,
+            settled: false,
+        }
+    }
+
+    /// After a communication step that ends at `time` (s) with the scale `scale` (m), for the
+    /// lowest period `first_period` (s); `resolved`: whether `ε D` is above the iteration's
+    /// resolution ([`FOLLOW_ABOVE`] × tolerance × size).
+    pub fn after_step(
+        self,
+        time: f64,
+        scale: f64,
+        first_period: f64,
+        resolved: bool,
+    ) -> ScaleSettling {
+        if self.settled {
+            self
+        } else if !resolved || scale > SETTLED_GROWTH * self.scale {
+            ScaleSettling {
+                since: time,
+                scale,
+                settled: false,
+            }
+        } else if time - self.since >= SETTLED_FOR * first_period * (1.0 - 1e-9) {
+            ScaleSettling {
+                settled: true,
+                ..self
+            }
+        } else {
+            self
+        }
+    }
+}
 
 /// A communication step whose largest `e / allowance` stayed below this moves one rung up (a
 /// doubled step multiplies the ratio by about 4: it lands below 1/2 of the allowance).
@@ -239,11 +328,13 @@ impl Ladder {
     ///
     /// `taken` is the rung of the internal steps the communication step took
     /// ([`level_of_step`]), `level` or coarser ones' equal: a refinement counts from it.
-    pub fn redo_level(&self, level: u32, taken: u32, ratio: f64) -> u32 {
+    ///
+    /// `finest`: the finest rung it may take ([`finest_level`]).
+    pub fn redo_level(&self, level: u32, taken: u32, ratio: f64, finest: u32) -> u32 {
         if self.probed && level == self.level {
-            (taken + 1).min(MAX_LEVEL)
+            (taken + 1).min(finest)
         } else {
-            finer_level(taken, ratio)
+            finer_level(taken, ratio, finest)
         }
     }
 
@@ -276,10 +367,11 @@ pub fn level_of_step(step_size: f64, h: f64) -> u32 {
 }
 
 /// The rung after a rejected communication step whose largest `e / allowance` was `ratio` (> 1):
-/// far enough down that the ratio falls below 1/2, at least one rung, at most [`MAX_LEVEL`].
-pub fn finer_level(level: u32, ratio: f64) -> u32 {
+/// far enough down that the ratio falls below 1/2, at least one rung, at most `finest`
+/// ([`finest_level`]).
+pub fn finer_level(level: u32, ratio: f64, finest: u32) -> u32 {
     let rungs = ((2.0 * ratio).log2() / RATIO_ORDER).ceil().max(1.0);
-    (level + rungs.min(MAX_LEVEL as f64) as u32).min(MAX_LEVEL)
+    (level + rungs.min(finest as f64) as u32).min(finest)
 }
 
 /// The allowance of an internal step `h` (m): `max(ε D h / H, floor)`, `H` the horizon (s).
@@ -324,16 +416,63 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_scale_settles_once_it_has_stopped_growing_for_a_sixteenth_of_the_period() {
+        let period = 1.6;
+        let window = SETTLED_FOR * period;
+        // Growing by 5 % per 0.01 s: never settles (10 % within 0.02 s < 0.1 s).
+        let mut s = ScaleSettling::at(0.0);
+        for k in 1..200 {
+            s = s.after_step(0.01 * k as f64, 1.05f64.powi(k), period, true);
+            assert!(!s.settled, "at step {k}");
+        }
+        // Steady after 0.5 s: settles one window later, and stays settled when it grows again.
+        let mut s = ScaleSettling::at(0.0);
+        let scale = |t: f64| 1e-3 * (t / 0.5).min(1.0);
+        let mut settled_at = None;
+        for k in 1..=100 {
+            let t = 0.01 * k as f64;
+            s = s.after_step(t, scale(t) * if t > 0.9 { 10.0 } else { 1.0 }, period, true);
+            if s.settled && settled_at.is_none() {
+                settled_at = Some(t);
+            }
+        }
+        let settled_at = settled_at.expect("settles");
+        // The last 10 % growth is at 0.46 s (0.46/0.5 × 1.1 > 1): settled 0.1 s after it.
+        assert!(
+            settled_at >= 0.46 + window - 1e-9 && settled_at <= 0.5 + window + 0.01,
+            "settled at {settled_at}"
+        );
+        assert!(s.settled);
+        // Below the iteration's resolution nothing counts.
+        let mut s = ScaleSettling::at(0.0);
+        for k in 1..100 {
+            s = s.after_step(0.01 * k as f64, 1e-20, period, false);
+        }
+        assert!(!s.settled);
+    }
+
+    #[test]
     fn the_finer_rung_brings_the_ratio_below_one_half() {
         // The ratio falls like h²: 4 per rung.
-        for &(ratio, expected) in &[(1.01, 1), (1.9, 1), (2.1, 2), (7.9, 2), (8.1, 3), (1e9, 8)] {
-            let level = finer_level(0, ratio);
+        for &(ratio, expected) in &[
+            (1.01, 1),
+            (1.9, 1),
+            (2.1, 2),
+            (7.9, 2),
+            (8.1, 3),
+            (1e9, MAX_LEVEL),
+        ] {
+            let level = finer_level(0, ratio, MAX_LEVEL);
             assert_eq!(level, expected, "ratio {ratio}");
             if level < MAX_LEVEL {
                 assert!(ratio / 4f64.powi(level as i32) < 0.5);
             }
         }
-        assert_eq!(finer_level(MAX_LEVEL - 1, 100.0), MAX_LEVEL);
+        assert_eq!(finer_level(MAX_LEVEL - 1, 100.0, MAX_LEVEL), MAX_LEVEL);
+        // Before the scale is established the ladder ends two rungs higher.
+        assert_eq!(finest_level(false), EARLY_MAX_LEVEL);
+        assert_eq!(finer_level(4, 1e9, finest_level(false)), EARLY_MAX_LEVEL);
+        assert_eq!(finer_level(4, 1e9, finest_level(true)), MAX_LEVEL);
     }
 
     #[test]
@@ -371,8 +510,11 @@ mod tests {
         assert!(grown.probed && grown.probe_after == PROBE_FIRST);
         // A failure on it goes back to the rung it grew from, however far the ratio would ask;
         // on a confirmed rung the ratio decides.
-        assert_eq!(grown.redo_level(2, 2, 2.31), 3);
-        assert_eq!(fresh.redo_level(3, 3, 2.31), finer_level(3, 2.31));
+        assert_eq!(grown.redo_level(2, 2, 2.31, MAX_LEVEL), 3);
+        assert_eq!(
+            fresh.redo_level(3, 3, 2.31, MAX_LEVEL),
+            finer_level(3, 2.31, MAX_LEVEL)
+        );
         // Rungs longer than the communication step take it whole: the refinement counts from
         // the rung of the step taken.
         assert_eq!(level_of_step(0.5, 2e-3), 7);
@@ -380,14 +522,14 @@ mod tests {
         assert_eq!(level_of_step(2e-3, 1e-3), 1);
         assert_eq!(level_of_step(2e-3, 2e-3 / 3.0), 1);
         assert_eq!(level_of_step(1.0, 1e-9), MAX_LEVEL);
-        assert_eq!(fresh.redo_level(0, 7, 2.31), 8);
-        assert_eq!(fresh.redo_level(0, 4, 2.31), 6);
+        assert_eq!(fresh.redo_level(0, 7, 2.31, MAX_LEVEL), 9);
+        assert_eq!(fresh.redo_level(0, 4, 2.31, MAX_LEVEL), 6);
         // An unconfirmed rung above rungs that take the same steps: from the step taken.
-        assert_eq!(grown.redo_level(2, 5, 2.31), 6);
+        assert_eq!(grown.redo_level(2, 5, 2.31, MAX_LEVEL), 6);
         // `internal_steps` splits a step within 1e-9 of a rung as that rung.
         assert_eq!(level_of_step(2e-3, 1e-3 * (1.0 + 5e-10)), 1);
         assert_eq!(level_of_step(2e-3, 1e-3 * (1.0 - 5e-10)), 1);
-        assert_eq!(finer_level(3, 2.31), 5);
+        assert_eq!(finer_level(3, 2.31, MAX_LEVEL), 5);
         let mut back = grown.after_refinement(3);
         assert_eq!(back.probe_after, 2 * PROBE_FIRST);
         for _ in 0..PROBE_FIRST {

@@ -6,8 +6,8 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    level_of_step, rung, within_ringing, Ladder, GROW_BELOW, MAX_LEVEL, MOTION_RINGING_STEPS,
-    NOISE_MARGIN,
+    finest_level, level_of_step, rung, within_ringing, Ladder, FOLLOW_ABOVE, GROW_BELOW,
+    MOTION_RINGING_STEPS, NOISE_MARGIN,
 };
 use super::{LogEvent, Slave};
 use crate::body::stiffening::driven_inertial_coefficients;
@@ -89,6 +89,8 @@ impl Slave {
             };
         }
         let mut level = ladder.level - u32::from(probing);
+        // The finest rung this step may refine to (step_control::finest_level).
+        let finest = finest_level(self.scale_established());
         self.step_inputs.copy_from(
             &self.inputs,
             &self.input_derivatives,
@@ -156,7 +158,7 @@ impl Slave {
             let mut result = Ok(());
             for i in 0..n {
                 result = self.internal_step(t0, big_h, i, n, h);
-                let redo = self.step_error.is_some_and(|r| r > 1.0) && taken_level < MAX_LEVEL;
+                let redo = self.step_error.is_some_and(|r| r > 1.0) && taken_level < finest;
                 if result.is_err() || redo {
                     break;
                 }
@@ -266,7 +268,7 @@ impl Slave {
                     continue;
                 }
             }
-            if result.is_ok() && ratio > 1.0 && taken_level < MAX_LEVEL {
+            if result.is_ok() && ratio > 1.0 && taken_level < finest {
                 // Redone from its start on a finer rung (docs/formulation.md, "Time error
                 // control"): a probe on the rung it came from (unless that rung takes the same
                 // internal steps); on a rung not yet confirmed, the rung it came from
@@ -277,7 +279,12 @@ impl Slave {
                 let finer = if probing && ladder.level > taken_level {
                     ladder.level
                 } else {
-                    ladder.redo_level(level, taken_level, ratio.max(self.step_error_unfloored))
+                    ladder.redo_level(
+                        level,
+                        taken_level,
+                        ratio.max(self.step_error_unfloored),
+                        finest,
+                    )
                 };
                 self.rejected += 1;
                 self.events.push(LogEvent {
@@ -377,7 +384,7 @@ impl Slave {
                 }
                 // Kept with its estimate above the allowance: only on the finest rung.
                 if let Some(ratio) = self.step_error.filter(|&r| r > 1.0) {
-                    self.count_beyond_finest(t0 + big_h, taken.1, ratio);
+                    self.count_beyond_finest(t0 + big_h, taken.1, ratio, finest);
                 }
                 self.finish_step(t0, big_h);
                 Ok(())
@@ -605,6 +612,15 @@ impl Slave {
                 &mut model.forces,
                 &mut self.scale_scratch,
                 dynamics,
+            );
+            // Whether `D` has settled (docs/formulation.md, "The iteration's tolerance").
+            let resolved = self.parameters.accuracy * dynamics.deformation_scale
+                >= FOLLOW_ABOVE * self.parameters.iteration_tolerance() * self.size;
+            dynamics.scale_settling = dynamics.scale_settling.after_step(
+                t0 + big_h,
+                dynamics.deformation_scale,
+                modes.first_period(),
+                resolved,
             );
         }
         self.outputs.invalidate();

@@ -212,14 +212,21 @@ pub(super) fn lowest_modes(
             "model.accuracy: the lowest natural frequency came out as {omega} rad/s; set model.accuracy = 0 for a fixed internal step"
         )));
     }
-    Ok(LowestModes::new(
+    let modes = LowestModes::new(
         &free.nodes[..free.elastic_nodes],
         &m_full,
         &pairs,
         index,
         total_mass,
         damping,
-    ))
+    );
+    // On a body without supports the deformation is measured from the nearest rigid motion,
+    // and its RMS is the scale itself (docs/formulation.md, "The deformation scale").
+    Ok(if supported || motions.is_some() {
+        modes
+    } else {
+        modes.with_free_body_mass(m_full)
+    })
 }
 
 /// `Tᵀ A T` of a symmetric `A` (dense: a reduced body's size).

@@ -3,9 +3,9 @@
 //! for one (docs/formulation.md, "Time error control").
 
 use super::super::interfaces::{apply_loads, prescribe_motion};
-use super::super::parameters::TOLERANCE_FLOOR;
 use super::super::step_control::{
-    allowance, error_ratio, within_ringing, FOLLOW_ABOVE, GROW_BELOW, ITERATION_NOISE,
+    allowance, error_ratio, within_ringing, FOLLOWING_TOLERANCE_FLOOR, FOLLOW_ABOVE, GROW_BELOW,
+    ITERATION_NOISE,
 };
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
@@ -95,13 +95,13 @@ impl Slave {
         let horizon = self.error_horizon();
         let accuracy = self.parameters.accuracy;
         let own_tolerance = self.parameters.iteration_tolerance();
-        // Past the first period (while the deformation scale still grows from 0, the floor is
-        // what the control needs), at the start of these internal steps: one test for the
-        // following tolerance and the floor's warning.
-        let after_first_period = self.after_first_period();
+        // Past the first period or with the deformation scale settled (while it still grows
+        // from 0, the floor is what the control needs), at the start of these internal steps:
+        // one test for the following tolerance and the floor's warning.
+        let scale_established = self.scale_established();
         // The rung's tolerance, also for a retry in smaller steps (a retry is for an iteration
         // that did not converge, which a tighter tolerance would not help).
-        let tolerance = after_first_period
+        let tolerance = scale_established
             .then(|| self.following_tolerance(rung))
             .flatten()
             .unwrap_or(own_tolerance);
@@ -245,12 +245,12 @@ impl Slave {
                 let judged_on_floor = ratio <= 1.0 && unfloored > 1.0;
                 // The iteration's tolerance, not the accuracy, passed this step even at the
                 // round-off's tolerance (docs/formulation.md, "Time error control": the
-                // iteration's tolerance). In the first period the deformation scale is still
-                // building up from 0, and a floor there is the one it needs.
+                // iteration's tolerance). While the deformation scale is still building up from
+                // 0, a floor there is the one it needs.
                 if judged_on_floor
                     && !self.floor_warned
                     && dynamics.estimate_floor < ITERATION_NOISE * floor
-                    && after_first_period
+                    && scale_established
                 {
                     self.floor_warned = true;
                     self.events.push(LogEvent {
@@ -259,7 +259,7 @@ impl Slave {
                             "warning: model.accuracy: at t = {:.6} an internal step of {hs:e} s was accepted on the iteration's floor, {ITERATION_NOISE} × tolerance × size = {:.3e} m, where model.accuracy allows {accuracy_allows:.3e} m: {}",
                             dynamics.state.time,
                             ITERATION_NOISE * floor,
-                            if tolerance <= TOLERANCE_FLOOR {
+                            if tolerance <= FOLLOWING_TOLERANCE_FLOOR {
                                 format!("the iteration's tolerance is at the round-off's {tolerance:e} (× size), below which the time error is not controlled")
                             } else {
                                 format!("below the iteration's tolerance ({tolerance:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on", accuracy_allows / (2.0 * ITERATION_NOISE * self.size))
@@ -278,10 +278,10 @@ impl Slave {
 impl Slave {
     /// The iteration's relative tolerance (× size) where it follows the allowance of internal
     /// steps of `hs` (s): `allowance / (2 × ITERATION_NOISE × size)`, not below
-    /// [`TOLERANCE_FLOOR`], where that is below the accuracy's own
+    /// [`FOLLOWING_TOLERANCE_FLOOR`], where that is below the accuracy's own
     /// ([`Parameters::iteration_tolerance`](super::super::parameters::Parameters::iteration_tolerance));
-    /// taken once the first period of the lowest mode has passed (docs/formulation.md, "Time
-    /// error control": the iteration's tolerance). `None`: the accuracy's own tolerance holds
+    /// taken once the first period of the lowest mode has passed or the deformation scale has
+    /// settled (docs/formulation.md, "Time error control": the iteration's tolerance). `None`: the accuracy's own tolerance holds
     /// (no error control, or an allowance above its floor).
     fn following_tolerance(&self, hs: f64) -> Option<f64> {
         let dynamics = self.dynamics.as_ref()?;
@@ -302,20 +302,23 @@ impl Slave {
             horizon,
             0.0,
         );
-        let tolerance = (allows / (2.0 * ITERATION_NOISE * self.size)).max(TOLERANCE_FLOOR);
+        let tolerance =
+            (allows / (2.0 * ITERATION_NOISE * self.size)).max(FOLLOWING_TOLERANCE_FLOOR);
         (tolerance < own).then_some(tolerance)
     }
 
-    /// Whether the body's time is past the first period `T₁` of its lowest mode since the start
-    /// (with the error control; docs/formulation.md, "Time error control": the iteration's
-    /// tolerance).
-    fn after_first_period(&self) -> bool {
+    /// Whether the deformation scale is established: the body's time is past the first period
+    /// `T₁` of its lowest mode since the start, or the scale has settled
+    /// ([`ScaleSettling`](super::super::step_control::ScaleSettling)) (with the error control;
+    /// docs/formulation.md, "Time error control": the iteration's tolerance).
+    pub(super) fn scale_established(&self) -> bool {
         match (
             self.model.as_ref().and_then(|m| m.lowest_modes.as_ref()),
             self.dynamics.as_ref(),
         ) {
             (Some(modes), Some(dynamics)) => {
-                dynamics.state.time - self.start_time > modes.first_period()
+                dynamics.scale_settling.settled
+                    || dynamics.state.time - self.start_time > modes.first_period()
             }
             _ => false,
         }
@@ -348,6 +351,14 @@ pub(super) fn observe_deformation(
             .unwrap_or_else(|| crate::linalg::dot(scratch.local_deformation(), elastic_force));
         modes.deformation(energy, elastic_force)
     });
+    // On a body without supports `ū` is the elastic displacement itself, and the energy's bound
+    // of the part above the lowest modes (`E/ω_top²`) can be far above it: a deformation far
+    // above `ω_top` (a free beam's stretch under its spin) carries its energy in few metres.
+    let above = modes
+        .free_body_rms(scratch.local_deformation())
+        .map_or(above, |rms| {
+            above.min((rms * rms - low * low).max(0.0).sqrt())
+        });
     dynamics.deformation_scale = dynamics.deformation_scale.max(low.hypot(above));
     dynamics.high_mode_scale = dynamics.high_mode_scale.max(above);
 }

@@ -2,7 +2,7 @@
 //! communication steps the error control could not judge or could not bring within
 //! `model.accuracy`, counted and warned of once, and the small-strain watch.
 
-use super::super::step_control::{rung, MAX_LEVEL, MOTION_RINGING_STEPS, UNESTIMATED_WARN_AFTER};
+use super::super::step_control::{rung, MOTION_RINGING_STEPS, UNESTIMATED_WARN_AFTER};
 use super::super::{LogEvent, Slave};
 use crate::body::strain_monitor::DEFAULT_THRESHOLD;
 use crate::model::category;
@@ -32,16 +32,16 @@ impl Slave {
     /// Counts a communication step (ending at `t`) kept on the finest rung, internal steps of
     /// `h`, whose largest estimate was `ratio` (> 1) × its allowance, and warns once: its time
     /// error is not within `model.accuracy` (docs/formulation.md, "Time error control": the
-    /// ladder).
-    pub(super) fn count_beyond_finest(&mut self, t: f64, h: f64, ratio: f64) {
+    /// ladder). `finest`: the finest rung in force (`step_control::finest_level`).
+    pub(super) fn count_beyond_finest(&mut self, t: f64, h: f64, ratio: f64, finest: u32) {
         self.beyond_finest.0 += 1;
         if !self.beyond_finest.1 {
             self.beyond_finest.1 = true;
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung (solver.stepSize / 2^{MAX_LEVEL} = {:e} s; internal steps of {h:e} s), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
-                    rung(self.parameters.step_size, MAX_LEVEL),
+                    "warning: model.accuracy: the communication step up to t = {t} was kept on the finest rung (solver.stepSize / 2^{finest} = {:e} s; internal steps of {h:e} s), with an estimated error {ratio:.2} × its allowance: the time error of such steps is not within model.accuracy = {:e}. A smaller solver.stepSize moves the ladder down, a larger model.accuracy asks for less (docs/formulation.md, \"Time error control\"); the run summary counts these steps",
+                    rung(self.parameters.step_size, finest),
                     self.parameters.accuracy
                 ),
             });
