@@ -124,6 +124,12 @@ impl LowestModes {
     /// On a body without supports ([`Self::with_free_body_mass`]), the mass-weighted RMS of the
     /// local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
     /// elastic nodes; `None` on a supported body. No allocation.
+    /// Whether the body has no supports ([`Self::with_free_body_mass`]): its deformation scale
+    /// is the RMS of `ū` itself.
+    pub fn without_supports(&self) -> bool {
+        self.free_body_mass.is_some()
+    }
+
     pub fn free_body_rms(&self, ubar: &[f64]) -> Option<f64> {
         let mass = self.free_body_mass.as_ref()?;
         let at = |dof: usize| ubar[3 * self.nodes[dof / 3] + dof % 3];

@@ -110,9 +110,9 @@ pub const SETTLED_FOR: f64 = 1.0 / 16.0;
 /// Whether the deformation scale `D` has settled (docs/formulation.md, "The iteration's
 /// tolerance"): it has not grown by [`SETTLED_GROWTH`] for [`SETTLED_FOR`] of the lowest period
 /// `T₁`, counted only while `ε D` is above the iteration's resolution. Once settled it stays
-/// settled, and the iteration's tolerance may follow the allowance before the first period
-/// has passed: errors committed then are judged against the scale of the run, not of a body
-/// still deforming.
+/// settled, and on a body without supports (whose `D` is the RMS of its local field itself) the
+/// iteration's tolerance may follow the allowance before the first period has passed: errors
+/// committed then are judged against the scale of the run, not of a body still deforming.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ScaleSettling {
     /// When `D` last grew by [`SETTLED_GROWTH`] (or was below the iteration's resolution), s.

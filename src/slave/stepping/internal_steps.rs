@@ -308,7 +308,8 @@ impl Slave {
     }
 
     /// Whether the deformation scale is established: the body's time is past the first period
-    /// `T₁` of its lowest mode since the start, or the scale has settled
+    /// `T₁` of its lowest mode since the start, or, on a body without supports (whose scale is
+    /// the RMS of its local field itself), the scale has settled
     /// ([`ScaleSettling`](super::super::step_control::ScaleSettling)) (with the error control;
     /// docs/formulation.md, "Time error control": the iteration's tolerance).
     pub(super) fn scale_established(&self) -> bool {
@@ -317,7 +318,7 @@ impl Slave {
             self.dynamics.as_ref(),
         ) {
             (Some(modes), Some(dynamics)) => {
-                dynamics.scale_settling.settled
+                (dynamics.scale_settling.settled && modes.without_supports())
                     || dynamics.state.time - self.start_time > modes.first_period()
             }
             _ => false,
