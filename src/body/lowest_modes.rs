@@ -121,15 +121,16 @@ impl LowestModes {
         self
     }
 
-    /// On a body without supports ([`Self::with_free_body_mass`]), the mass-weighted RMS of the
-    /// local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
-    /// elastic nodes; `None` on a supported body. No allocation.
     /// Whether the body has no supports ([`Self::with_free_body_mass`]): its deformation scale
     /// is the RMS of `ū` itself.
     pub fn without_supports(&self) -> bool {
         self.free_body_mass.is_some()
     }
 
+    /// On a body without supports ([`Self::with_free_body_mass`]), the mass-weighted RMS of the
+    /// local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
+    /// elastic nodes (`m`: the body's mass, lumped points included, as for the lowest modes'
+    /// part); `None` on a supported body. No allocation.
     pub fn free_body_rms(&self, ubar: &[f64]) -> Option<f64> {
         let mass = self.free_body_mass.as_ref()?;
         let at = |dof: usize| ubar[3 * self.nodes[dof / 3] + dof % 3];
@@ -367,6 +368,32 @@ mod tests {
         let free = modes.with_free_body_mass(SymmetricCsr::from_triplets(6, &identity));
         let rms = free.free_body_rms(&[1.0, 0.0, 2.0, 0.0, 3.0, 0.0]).unwrap();
         assert!((rms - 7f64.sqrt()).abs() < 1e-15, "{rms}");
+        // The free nodes in another order than the body's (nodes 2 and 0 of three, node 1
+        // held) and a mass coupling them, [[2, 1], [1, 2]] ⊗ I3: with ū₂ = (1, 0, 3) and
+        // ū₀ = (1, 0, 0), ūᵀ M ū = (2 + 2 + 2) + 2 × 9 = 24, over 2 kg.
+        let coupled: Vec<_> = (0..3)
+            .flat_map(|c| {
+                [
+                    (c, c, 2.0),
+                    (c, c + 3, 1.0),
+                    (c + 3, c, 1.0),
+                    (c + 3, c + 3, 2.0),
+                ]
+            })
+            .collect();
+        let mass = SymmetricCsr::from_triplets(6, &coupled);
+        let mut e1 = vec![0.0; 6];
+        e1[0] = 1.0;
+        let pairs = EigenPairs {
+            eigenvalues: vec![1.0],
+            modes: vec![e1],
+            iterations: 1,
+        };
+        let reordered =
+            LowestModes::new(&[2, 0], &mass, &pairs, 0, 2.0, (0.0, 0.0)).with_free_body_mass(mass);
+        let ubar = [1.0, 0.0, 0.0, 100.0, 100.0, 100.0, 1.0, 0.0, 3.0];
+        let rms = reordered.free_body_rms(&ubar).unwrap();
+        assert!((rms - 12f64.sqrt()).abs() < 1e-14, "{rms}");
     }
 
     #[test]

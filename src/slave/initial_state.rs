@@ -151,9 +151,10 @@ impl Slave {
             self.events.push(LogEvent {
                 category: category::EVENTS,
                 message: format!(
-                    "model.accuracy = {:e}: the internal step is chosen from solver.stepSize / 2^k (k ≤ {}) so that the estimated errors that last {over} add up to at most model.accuracy × the deformation scale",
+                    "model.accuracy = {:e}: the internal step is chosen from solver.stepSize / 2^k (k ≤ {}; ≤ {} until the deformation scale is established) so that the estimated errors that last {over} add up to at most model.accuracy × the deformation scale",
                     self.parameters.accuracy,
-                    super::step_control::MAX_LEVEL
+                    super::step_control::MAX_LEVEL,
+                    super::step_control::EARLY_MAX_LEVEL
                 ),
             });
         }

@@ -93,8 +93,9 @@ struct Dynamics {
     /// When `model.auto` switched the slabs' own stiffening on (s; `None` where it was forced
     /// on or is off): it comes in over the lowest period from then (`SlabStiffeningSwitch::scale`).
     slab_stiffening_since: Option<f64>,
-    /// Whether `D` has settled, so that the iteration's tolerance may follow the allowance
-    /// before the first period has passed ([`step_control::ScaleSettling`]).
+    /// Whether `D` has settled, so that on a body without supports the iteration's tolerance may
+    /// follow the allowance, and the ladder reach its two finest rungs, before the first period
+    /// has passed ([`step_control::ScaleSettling`], `step_control::finest_level`).
     scale_settling: step_control::ScaleSettling,
 }
 

@@ -95,8 +95,9 @@ impl Slave {
         let horizon = self.error_horizon();
         let accuracy = self.parameters.accuracy;
         let own_tolerance = self.parameters.iteration_tolerance();
-        // Past the first period or with the deformation scale settled (while it still grows
-        // from 0, the floor is what the control needs), at the start of these internal steps:
+        // Past the first period, or on a body without supports with the deformation scale
+        // settled (while it still grows from 0, the floor is what the control needs), at the
+        // start of these internal steps:
         // one test for the following tolerance and the floor's warning.
         let scale_established = self.scale_established();
         // The rung's tolerance, also for a retry in smaller steps (a retry is for an iteration
@@ -260,7 +261,7 @@ impl Slave {
                             dynamics.state.time,
                             ITERATION_NOISE * floor,
                             if tolerance <= FOLLOWING_TOLERANCE_FLOOR {
-                                format!("the iteration's tolerance is at the round-off's {tolerance:e} (× size), below which the time error is not controlled")
+                                format!("the iteration's tolerance is at its floor, {tolerance:e} (× size), below which the time error is not controlled")
                             } else {
                                 format!("below the iteration's tolerance ({tolerance:e}) the time error is not controlled; solver.tolerance = {:.1e} would let the control go on", accuracy_allows / (2.0 * ITERATION_NOISE * self.size))
                             }
@@ -280,9 +281,9 @@ impl Slave {
     /// steps of `hs` (s): `allowance / (2 × ITERATION_NOISE × size)`, not below
     /// [`FOLLOWING_TOLERANCE_FLOOR`], where that is below the accuracy's own
     /// ([`Parameters::iteration_tolerance`](super::super::parameters::Parameters::iteration_tolerance));
-    /// taken once the first period of the lowest mode has passed or the deformation scale has
-    /// settled (docs/formulation.md, "Time error control": the iteration's tolerance). `None`: the accuracy's own tolerance holds
-    /// (no error control, or an allowance above its floor).
+    /// taken once the deformation scale is established ([`Self::scale_established`];
+    /// docs/formulation.md, "Time error control": the iteration's tolerance). `None`: the
+    /// accuracy's own tolerance holds (no error control, or an allowance above its floor).
     fn following_tolerance(&self, hs: f64) -> Option<f64> {
         let dynamics = self.dynamics.as_ref()?;
         let horizon = self.error_horizon()?;
