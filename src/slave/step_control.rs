@@ -67,6 +67,13 @@ pub const ITERATION_NOISE: f64 = 10.0;
 /// round-off refined it to 4 µs for its whole swing.
 pub const FOLLOW_ABOVE: f64 = 1e3;
 
+/// Whether the budget `ε D` (`accuracy` × `scale`, m) is above the iteration's resolution,
+/// [`FOLLOW_ABOVE`] × `tolerance` × `size` (m): only then does the iteration's tolerance follow
+/// the allowance, and does the deformation scale's settling count ([`ScaleSettling`]).
+pub fn above_resolution(accuracy: f64, scale: f64, tolerance: f64, size: f64) -> bool {
+    accuracy * scale >= FOLLOW_ABOVE * tolerance * size
+}
+
 /// An estimate that refining did not reduce becomes a floor of the allowance with this margin,
 /// so that the rung it came from is judged within its allowance.
 pub const NOISE_MARGIN: f64 = 4.0;

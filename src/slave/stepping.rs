@@ -6,7 +6,7 @@ use super::auto_features::{
 };
 use super::interfaces::extrapolate;
 use super::step_control::{
-    finest_level, level_of_step, rung, within_ringing, Ladder, FOLLOW_ABOVE, GROW_BELOW,
+    above_resolution, finest_level, level_of_step, rung, within_ringing, Ladder, GROW_BELOW,
     MOTION_RINGING_STEPS, NOISE_MARGIN,
 };
 use super::{LogEvent, Slave};
@@ -614,8 +614,12 @@ impl Slave {
                 dynamics,
             );
             // Whether `D` has settled (docs/formulation.md, "The iteration's tolerance").
-            let resolved = self.parameters.accuracy * dynamics.deformation_scale
-                >= FOLLOW_ABOVE * self.parameters.iteration_tolerance() * self.size;
+            let resolved = above_resolution(
+                self.parameters.accuracy,
+                dynamics.deformation_scale,
+                self.parameters.iteration_tolerance(),
+                self.size,
+            );
             dynamics.scale_settling = dynamics.scale_settling.after_step(
                 t0 + big_h,
                 dynamics.deformation_scale,

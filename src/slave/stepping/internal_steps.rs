@@ -4,8 +4,8 @@
 
 use super::super::interfaces::{apply_loads, prescribe_motion};
 use super::super::step_control::{
-    allowance, error_ratio, within_ringing, FOLLOWING_TOLERANCE_FLOOR, FOLLOW_ABOVE, GROW_BELOW,
-    ITERATION_NOISE,
+    above_resolution, allowance, error_ratio, within_ringing, FOLLOWING_TOLERANCE_FLOOR,
+    GROW_BELOW, ITERATION_NOISE,
 };
 use super::super::{LogEvent, Slave};
 use super::MAX_STEP_HALVINGS;
@@ -293,7 +293,12 @@ impl Slave {
         // A deformation within `FOLLOW_ABOVE` of the iteration's own tolerances is at its
         // resolution: the floor stands (a nearly rigid pendulum, `D` 1e-8 of its size).
         let own = self.parameters.iteration_tolerance();
-        if self.parameters.accuracy * dynamics.deformation_scale < FOLLOW_ABOVE * own * self.size {
+        if !above_resolution(
+            self.parameters.accuracy,
+            dynamics.deformation_scale,
+            own,
+            self.size,
+        ) {
             return None;
         }
         let allows = allowance(
