@@ -53,9 +53,8 @@ pub struct LowestModes {
     decay_rates: [f64; MODES + 1],
     /// The body's mass `m` (kg).
     total_mass: f64,
-    /// On a body without supports, `M` of the free elastic nodes (`3n × 3n`, in the order of
-    /// `nodes`), for the RMS of `ū` itself ([`Self::free_body_rms`]); `None` otherwise.
-    free_body_mass: Option<SymmetricCsr>,
+    /// Whether the body has no supports ([`Self::without_supports`]).
+    free_body: bool,
 }
 
 impl LowestModes {
@@ -108,36 +107,42 @@ impl LowestModes {
             omega_top_sq,
             decay_rates,
             total_mass,
-            free_body_mass: None,
+            free_body: false,
         }
     }
 
     /// The same on a body without supports, whose local deformation `ū` is measured from the
     /// best-fit frame, the nearest rigid motion: its mass-weighted RMS is then the elastic
-    /// displacement itself ([`Self::free_body_rms`]). `mass`: `M ⊗ I3` of `nodes`, as for
-    /// [`Self::new`].
-    pub fn with_free_body_mass(mut self, mass: SymmetricCsr) -> LowestModes {
-        self.free_body_mass = Some(mass);
+    /// displacement itself ([`Self::free_body_rms`]).
+    pub fn for_body_without_supports(mut self) -> LowestModes {
+        self.free_body = true;
         self
     }
 
-    /// Whether the body has no supports ([`Self::with_free_body_mass`]): its deformation scale
-    /// is the RMS of `ū` itself.
+    /// Whether the body has no supports ([`Self::for_body_without_supports`]): its deformation
+    /// scale is the RMS of `ū` itself.
     pub fn without_supports(&self) -> bool {
-        self.free_body_mass.is_some()
+        self.free_body
     }
 
-    /// On a body without supports ([`Self::with_free_body_mass`]), the mass-weighted RMS of the
-    /// local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
-    /// elastic nodes (`m`: the body's mass, lumped points included, as for the lowest modes'
-    /// part); `None` on a supported body. No allocation.
-    pub fn free_body_rms(&self, ubar: &[f64]) -> Option<f64> {
-        let mass = self.free_body_mass.as_ref()?;
+    /// On a body without supports ([`Self::for_body_without_supports`]), the mass-weighted RMS of
+    /// the local deformation `ū` (flat `3N`, co-moving frame, m): `√(ūᵀ M ū / m)` over the free
+    /// elastic nodes, with `mass` the free DOFs' `M ⊗ I3` (`FreeNodes::mass`, whose first rows
+    /// are those nodes', in the order of the modes' nodes; `m`: the body's mass, lumped points
+    /// included, as for the lowest modes' part); `None` on a supported body. No allocation.
+    pub fn free_body_rms(&self, mass: &SymmetricCsr, ubar: &[f64]) -> Option<f64> {
+        if !self.free_body {
+            return None;
+        }
+        let dofs = 3 * self.nodes.len();
         let at = |dof: usize| ubar[3 * self.nodes[dof / 3] + dof % 3];
         let mut squared = 0.0;
-        for row in 0..mass.n {
+        for row in 0..dofs {
             let (cols, values) = mass.row(row);
-            let m_u: f64 = cols.iter().zip(values).map(|(&c, v)| v * at(c)).sum();
+            let m_u: f64 = (cols.iter().zip(values))
+                .filter(|(&c, _)| c < dofs)
+                .map(|(&c, v)| v * at(c))
+                .sum();
             squared += at(row) * m_u;
         }
         Some((squared.max(0.0) / self.total_mass).sqrt())
@@ -362,11 +367,14 @@ mod tests {
     fn a_body_without_supports_measures_its_deformation_by_the_rms_of_its_local_field() {
         let modes = two_oscillators((0.0, 0.0));
         // Supported: no such measure.
-        assert!(modes.free_body_rms(&[1.0; 6]).is_none());
-        // Unit masses, body mass 2 kg: √((1² + 2² + 3²) / 2) from both nodes' components.
         let identity: Vec<_> = (0..6).map(|i| (i, i, 1.0)).collect();
-        let free = modes.with_free_body_mass(SymmetricCsr::from_triplets(6, &identity));
-        let rms = free.free_body_rms(&[1.0, 0.0, 2.0, 0.0, 3.0, 0.0]).unwrap();
+        let identity = SymmetricCsr::from_triplets(6, &identity);
+        assert!(modes.free_body_rms(&identity, &[1.0; 6]).is_none());
+        // Unit masses, body mass 2 kg: √((1² + 2² + 3²) / 2) from both nodes' components.
+        let free = modes.for_body_without_supports();
+        let rms = free
+            .free_body_rms(&identity, &[1.0, 0.0, 2.0, 0.0, 3.0, 0.0])
+            .unwrap();
         assert!((rms - 7f64.sqrt()).abs() < 1e-15, "{rms}");
         // The free nodes in another order than the body's (nodes 2 and 0 of three, node 1
         // held) and a mass coupling them, [[2, 1], [1, 2]] ⊗ I3: with ū₂ = (1, 0, 3) and
@@ -389,10 +397,10 @@ mod tests {
             modes: vec![e1],
             iterations: 1,
         };
-        let reordered =
-            LowestModes::new(&[2, 0], &mass, &pairs, 0, 2.0, (0.0, 0.0)).with_free_body_mass(mass);
+        let reordered = LowestModes::new(&[2, 0], &mass, &pairs, 0, 2.0, (0.0, 0.0))
+            .for_body_without_supports();
         let ubar = [1.0, 0.0, 0.0, 100.0, 100.0, 100.0, 1.0, 0.0, 3.0];
-        let rms = reordered.free_body_rms(&ubar).unwrap();
+        let rms = reordered.free_body_rms(&mass, &ubar).unwrap();
         assert!((rms - 12f64.sqrt()).abs() < 1e-14, "{rms}");
     }
 

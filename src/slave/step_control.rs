@@ -58,9 +58,10 @@ pub const ITERATION_NOISE: f64 = 10.0;
 
 /// The iteration's tolerance follows the allowance of the internal steps where the floor would
 /// pass their errors ([`ITERATION_NOISE`] × tolerance × size above the allowance), once the
-/// deformation scale is established (the first period has passed, or on a body without supports
-/// the scale has settled: [`ScaleSettling`]), and only for a deformation whose whole budget `ε D` is at least this many
-/// of the iteration's own tolerances `tolerance × size`: below, the deformation is at the
+/// deformation scale is established (the first period has passed, or on a body without
+/// supports the scale has settled: [`ScaleSettling`]), and only for a deformation whose whole
+/// budget `ε D` is at least this many of the iteration's own tolerances `tolerance × size`
+/// ([`above_resolution`]): below, the deformation is at the
 /// iteration's resolution and the floor stands (docs/formulation.md, "Time error control": the
 /// iteration's tolerance). B2 at `ε = 1e-3`: `ε D` is 1.8e5 of them, and it follows; a nearly
 /// rigid pendulum (`D` 1e-8 of its size at `ε = 1e-2`): 1, and following its allowance down to

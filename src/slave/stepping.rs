@@ -608,6 +608,7 @@ impl Slave {
             let dynamics = self.dynamics.as_mut().unwrap();
             observe_deformation(
                 &model.body,
+                &model.free,
                 modes,
                 &mut model.forces,
                 &mut self.scale_scratch,

@@ -225,7 +225,7 @@ pub(super) fn lowest_modes(
     Ok(if supported || motions.is_some() {
         modes
     } else {
-        modes.with_free_body_mass(m_full)
+        modes.for_body_without_supports()
     })
 }
 

@@ -211,6 +211,7 @@ impl Slave {
                     .expect("error control has the modes");
                 observe_deformation(
                     body,
+                    &model.free,
                     modes,
                     &mut model.forces,
                     &mut self.scale_scratch,
@@ -335,9 +336,12 @@ impl Slave {
 /// The scales of the error control (docs/formulation.md, "Time error control") after a step:
 /// `D` and `A` grow to the elastic displacement relative to the supports of the state the last
 /// residual was evaluated at, and to its part above the lowest modes
-/// ([`LowestModes::deformation`]); `y` is scratch of `3N`. No allocation.
+/// ([`LowestModes::deformation`]; on a body without supports, no more than the RMS of `ū` by the
+/// free DOFs' mass `free.mass`, [`LowestModes::free_body_rms`]); `y` is scratch of `3N`. No
+/// allocation.
 pub(super) fn observe_deformation(
     body: &crate::body::Body,
+    free: &crate::solver::problem::FreeNodes,
     modes: &LowestModes,
     forces: &mut crate::solver::problem::ResidualWorkspace,
     y: &mut [f64],
@@ -362,7 +366,7 @@ pub(super) fn observe_deformation(
     // of the part above the lowest modes (`E/ω_top²`) can be far above it: a deformation far
     // above `ω_top` (a free beam's stretch under its spin) carries its energy in few metres.
     let above = modes
-        .free_body_rms(scratch.local_deformation())
+        .free_body_rms(&free.mass, scratch.local_deformation())
         .map_or(above, |rms| {
             above.min((rms * rms - low * low).max(0.0).sqrt())
         });
