@@ -96,6 +96,7 @@ fn initial_state(c: &Cantilever) -> DynamicState {
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
         step_size: 0.0,
+        iteration_error_ratio: f64::INFINITY,
     }
 }
 
@@ -127,6 +128,7 @@ fn pulse_run(
     .unwrap();
     let settings = IterationSettings {
         absolute_tolerance: 1e-14,
+        carried_below: 0.0,
         max_iterations: 50,
         estimate_error: None,
     };
@@ -320,6 +322,7 @@ fn steps_from(
     state.step_size = 0.0;
     let settings = IterationSettings {
         absolute_tolerance: 1e-14,
+        carried_below: 0.0,
         max_iterations: 50,
         estimate_error: Some(0.0),
     };

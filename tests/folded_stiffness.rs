@@ -150,6 +150,7 @@ fn step_and_remaining_correction(body: &Body, free: &FreeNodes) -> (f64, f64) {
     };
     let settings = IterationSettings {
         absolute_tolerance: 1e-13,
+        carried_below: 0.0,
         max_iterations: 50,
         estimate_error: None,
     };

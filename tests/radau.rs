@@ -73,6 +73,7 @@ fn run_from(
         pseudo_acceleration: vec![0.0; n3],
         multipliers: vec![],
         step_size: 0.0,
+        iteration_error_ratio: f64::INFINITY,
     };
     let loads = |t: f64, _x: &[f64], out: &mut [f64]| {
         if !pulse {
@@ -91,6 +92,7 @@ fn run_from(
     };
     let settings = IterationSettings {
         absolute_tolerance: 1e-15,
+        carried_below: 0.0,
         max_iterations: 50,
         estimate_error: None,
     };

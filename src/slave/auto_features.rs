@@ -29,6 +29,7 @@ pub(super) fn choose_features(
     events: &mut Vec<LogEvent>,
     scratch: &mut [f64],
 ) {
+    let before = dynamics.features;
     if let Some(indicators) = model.indicators.as_mut() {
         let s = &dynamics.state;
         let e = indicators.estimate(&model.body, &s.position, &s.velocity, &s.acceleration);
@@ -105,6 +106,10 @@ pub(super) fn choose_features(
         choose_linear(model, dynamics, accuracy, events);
     }
     model.apply_features(dynamics.features);
+    if dynamics.features != before {
+        // Another model, another contraction: measured again.
+        dynamics.state.iteration_error_ratio = f64::INFINITY;
+    }
 }
 
 /// A switch of `model.auto` with hysteresis: a term that is off goes on when `value` exceeds
@@ -440,6 +445,7 @@ pub(super) fn choose_slab_stiffening(
         patches.update_stiffening(x, false, 0.0);
         dynamics.features.slab_stiffening = true;
         model.apply_features(dynamics.features);
+        dynamics.state.iteration_error_ratio = f64::INFINITY;
         events.push(LogEvent {
             category: category::EVENTS,
             message: format!(

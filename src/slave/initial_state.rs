@@ -78,6 +78,7 @@ impl Slave {
             pseudo_acceleration: vec![0.0; 3 * n],
             multipliers: vec![0.0; model.free.multiplier_count()],
             step_size: 0.0,
+            iteration_error_ratio: f64::INFINITY,
         };
         body.place_rigidly(
             &placement.origin,

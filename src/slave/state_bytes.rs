@@ -17,7 +17,7 @@
 //! | stop time | u8 (1: defined), f64 (0 when not) |
 //! | counters | internal steps, iterations, retries, rejected steps: u64 |
 //! | dynamics present | u8 (0 before initialization) |
-//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the slabs' stiffening ratio last measured f64; whether `model.auto` switched the slabs' own stiffening on: u8; when: f64 (0 when not); since when the deformation scale has not grown by 10 % f64, the scale then f64, whether it has settled u8; the last internal step's length f64 (0: none) |
+//! | dynamics | time f64; `3N` u64; positions, velocities, accelerations, pseudo-accelerations `3N` f64 each; multipliers: u64 count, f64 each; loads `n × 30` f64; gravity[3] f64; terms in force u8 (bit 0 f_nl, bit 1 stiffening, bit 2 model.auto's slabs, bit 3 slabs refused, bit 4 the linear body, bit 5 the slabs' own stiffening); since when their indicators are quiet [3] f64 (f64::MAX: not); step level, calm steps on it, steps the next probe waits for: u32; whether the rung came from a probe not yet confirmed: u8; internal steps since a motion input last jumped: u32; whether that jump came within 8 internal steps of the one before: u8; deformation scale f64; the scale of the modes above the lowest f64; the estimate floor f64; the slabs' stiffening ratio last measured f64; whether `model.auto` switched the slabs' own stiffening on: u8; when: f64 (0 when not); since when the deformation scale has not grown by 10 % f64, the scale then f64, whether it has settled u8; the last internal step's length f64 (0: none); whether its iteration's error ratio is carried u8, that ratio f64 (0 when not) |
 //!
 //! Reading checks every count against this body (interfaces, nodes, constraint multipliers), every
 //! number for finiteness and the parameters' ranges, so a damaged or foreign payload is an error
@@ -33,7 +33,7 @@ use crate::solver::problem::DynamicState;
 use nalgebra::{Matrix3, Vector3};
 
 /// Version of the payload layout above; bump it when the layout changes.
-pub const PAYLOAD_FORMAT: u32 = 17;
+pub const PAYLOAD_FORMAT: u32 = 18;
 
 struct Writer<'a>(&'a mut Vec<u8>);
 
@@ -254,6 +254,13 @@ impl SlaveState {
                 w.f64(d.scale_settling.scale);
                 w.u8(u8::from(d.scale_settling.settled));
                 w.f64(s.step_size);
+                let carried = s.iteration_error_ratio.is_finite();
+                w.u8(u8::from(carried));
+                w.f64(if carried {
+                    s.iteration_error_ratio
+                } else {
+                    0.0
+                });
             }
         }
     }
@@ -533,6 +540,14 @@ impl Slave {
                         "the serialized FMU state holds {step_size} for the last internal step's length: not finite and at least 0"
                     )));
                 }
+                let carried = r.u8("whether an iteration's error ratio is carried")? != 0;
+                let ratio = r.f64("the iteration's error ratio")?;
+                if ratio < 0.0 {
+                    return Err(Error::new(format!(
+                        "the serialized FMU state holds {ratio} for the iteration's error ratio: not at least 0"
+                    )));
+                }
+                let iteration_error_ratio = if carried { ratio } else { f64::INFINITY };
                 let [position, velocity, acceleration, pseudo_acceleration] = vectors;
                 Some(Dynamics {
                     state: DynamicState {
@@ -543,6 +558,7 @@ impl Slave {
                         pseudo_acceleration,
                         multipliers: lambda,
                         step_size,
+                        iteration_error_ratio,
                     },
                     loads,
                     gravity,

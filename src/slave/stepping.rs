@@ -175,6 +175,7 @@ impl Slave {
                 dynamics.features.frames_refused = true;
                 dynamics.features.slab_stiffening = false;
                 dynamics.slab_stiffening_since = None;
+                dynamics.state.iteration_error_ratio = f64::INFINITY;
                 let model = self.model.as_mut().unwrap();
                 model.apply_features(dynamics.features);
                 self.events.push(LogEvent {
@@ -204,6 +205,7 @@ impl Slave {
                 dynamics.state.copy_from(self.backup.as_ref().unwrap());
                 dynamics.features.linear = false;
                 dynamics.quiet_since[2] = NOT_QUIET;
+                dynamics.state.iteration_error_ratio = f64::INFINITY;
                 self.model
                     .as_mut()
                     .unwrap()

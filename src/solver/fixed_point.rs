@@ -7,7 +7,10 @@
 //!
 //! - is converged when `Δ_k ≤ tol`, or (generalized-α; not Radau IIA, see
 //!   [`Convergence::correction_only`]) when the error estimate of a linearly converging
-//!   iteration, `θ/(1−θ) Δ_k` with `θ = Δ_k/Δ_{k−1}` ([`remaining_error`]), is `≤ tol`;
+//!   iteration, `θ/(1−θ) Δ_k` with `θ = Δ_k/Δ_{k−1}` ([`remaining_error`]), is `≤ tol`; on the
+//!   first correction, with the ratio the step before ended with ([`Convergence::carrying`]),
+//!   when `η₀ Δ₁ ≤ 0.1 tol` ([`CARRIED_MARGIN`]) and `Δ₁` is within the iteration's own
+//!   tolerance where `tol` follows the error control below it;
 //! - fails (an [`Error::discard`]) when a correction is not finite, or after the iteration limit;
 //! - otherwise replaces the plain `g_k` with Anderson's mixed update ([`super::anderson`]) before
 //!   it is applied; the stopping test is decided on the plain correction, which is then the one
@@ -30,13 +33,43 @@ pub const TRUSTED_CONTRACTION: f64 = 0.5;
 /// B1), so this accepts after two iterations a step that the correction alone accepts after
 /// three, with an estimated error far below the tolerance.
 pub fn remaining_error(correction: f64, previous_correction: f64) -> f64 {
-    let theta = correction / previous_correction;
-    if previous_correction.is_finite() && theta.is_finite() && theta <= TRUSTED_CONTRACTION {
-        theta / (1.0 - theta) * correction
+    let ratio = error_ratio(correction, previous_correction);
+    if ratio.is_finite() {
+        ratio * correction
     } else {
         f64::INFINITY
     }
 }
+
+/// `η = θ/(1−θ)` of [`remaining_error`] with `θ = ‖Δ_k‖/‖Δ_{k−1}‖`: the error left after a
+/// correction in units of it (infinity when `θ` exceeds [`TRUSTED_CONTRACTION`] or is unknown).
+pub fn error_ratio(correction: f64, previous_correction: f64) -> f64 {
+    let theta = correction / previous_correction;
+    if previous_correction.is_finite() && theta.is_finite() && theta <= TRUSTED_CONTRACTION {
+        theta / (1.0 - theta)
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The error ratio a step's first correction is judged with, from the ratio `η` its
+/// predecessor's iteration ended with (Hairer & Wanner, *Solving ODEs II*, IV.8):
+/// `η₀ = max(η, ε)^0.8`, `ε` the machine epsilon. The power lets a ratio carried over steps
+/// that stop on their first correction grow, so that every few steps a second correction
+/// measures it again (1e-6 grows past 1e-2 in six steps).
+pub fn carried_error_ratio(previous: f64) -> f64 {
+    previous.max(f64::EPSILON).powf(CARRIED_GROWTH)
+}
+
+/// See [`carried_error_ratio`].
+pub const CARRIED_GROWTH: f64 = 0.8;
+
+/// A first correction `Δ₁` judged with the carried ratio `η₀` ([`carried_error_ratio`]) stops
+/// the iteration when `η₀ Δ₁ ≤ CARRIED_MARGIN × tol` (and `Δ₁` is within the own tolerance,
+/// [`IterationSettings::carried_below`]): the carried ratio predicts this step's contraction,
+/// which the load or the motion may have changed since (docs/formulation.md, "The stopping
+/// rule").
+pub const CARRIED_MARGIN: f64 = 0.1;
 
 /// `max(largest, ‖dx‖_∞)`, or infinity if an entry of `dx` is not finite: a non-finite
 /// correction never counts as converged (`f64::max` would drop a NaN).
@@ -70,6 +103,9 @@ pub struct Convergence {
     /// Whether the estimate [`remaining_error`] may accept an iterate (see
     /// [`Self::correction_only`]).
     trust_estimate: bool,
+    /// The error ratio `η` ([`error_ratio`]) of the last iteration, or before the second the
+    /// one carried from the previous step ([`carried_error_ratio`]; infinity: none).
+    ratio: f64,
 }
 
 impl Convergence {
@@ -87,7 +123,25 @@ impl Convergence {
             step_size: h,
             last_correction: f64::INFINITY,
             trust_estimate: true,
+            ratio: f64::INFINITY,
         }
+    }
+
+    /// The same tracker judging the first correction with the error ratio `previous` that
+    /// the step before ended with ([`Self::error_ratio`]), grown by [`carried_error_ratio`]:
+    /// a step whose iteration contracts as its predecessor's stops on its first correction
+    /// `Δ₁` when `η₀ Δ₁ ≤` [`CARRIED_MARGIN`] `× tol` and `Δ₁ ≤`
+    /// [`IterationSettings::carried_below`]. Infinity (a new step size or model, no step yet)
+    /// carries nothing.
+    pub fn carrying(mut self, previous: f64) -> Convergence {
+        self.ratio = carried_error_ratio(previous);
+        self
+    }
+
+    /// The error ratio `η` to carry to the next step: the last one measured, or if the step
+    /// stopped on its first correction the one it was judged with.
+    pub fn error_ratio(&self) -> f64 {
+        self.ratio
     }
 
     /// The same tracker accepting on the correction alone (`Δ_k ≤ tol`), never on the estimate.
@@ -114,8 +168,19 @@ impl Convergence {
             )));
         }
         let tolerance = self.settings.absolute_tolerance;
-        let converged = largest <= tolerance
-            || (self.trust_estimate && remaining_error(largest, self.last_correction) <= tolerance);
+        if self.last_correction.is_finite() {
+            self.ratio = error_ratio(largest, self.last_correction);
+        }
+        // A ratio measured in this step's iteration judges its correction as it is; one carried
+        // from the step before is a prediction: it judges a first correction with a margin, and
+        // only one the plain test would pass at `carried_below`.
+        let estimated = if self.last_correction.is_finite() {
+            self.ratio * largest <= tolerance
+        } else {
+            largest <= self.settings.carried_below
+                && self.ratio * largest <= CARRIED_MARGIN * tolerance
+        };
+        let converged = largest <= tolerance || (self.trust_estimate && estimated);
         self.last_correction = largest;
         Ok(converged)
     }
@@ -174,9 +239,63 @@ mod tests {
     }
 
     #[test]
+    fn a_step_judges_its_first_correction_with_the_ratio_carried_from_the_step_before() {
+        // A tolerance of 1e-6 m followed below the own 1e-2 m.
+        let settings = IterationSettings {
+            absolute_tolerance: 1e-6,
+            carried_below: 1e-2,
+            max_iterations: 10,
+            estimate_error: None,
+        };
+        // The step before contracted by θ = 1e-6: η₀ = (1e-6/(1 − 1e-6))^0.8 = 1.6e-5, and a
+        // first correction of 1e-4 m leaves 1.6e-9 m ≤ 0.1 × 1e-6.
+        let eta = 1e-6 / (1.0 - 1e-6);
+        let mut c = Convergence::new("", &settings, 1.0, 0.1).carrying(eta);
+        assert!(c.converged(1e-4).unwrap());
+        let grown = c.error_ratio();
+        assert!((grown - eta.powf(0.8)).abs() <= 1e-12 * grown, "{grown}");
+        // Carried on over steps that stop at once, it grows until a first correction is no
+        // longer enough: two more steps judged with 1.4e-4 and 8.5e-4 (a correction of 1e-4 m
+        // leaves 8.5e-8 m), then 3.5e-3 (3.5e-7 m: not).
+        let mut steps = 1;
+        let mut ratio = grown;
+        loop {
+            let mut c = Convergence::new("", &settings, 1.0, 0.1).carrying(ratio);
+            if !c.converged(1e-4).unwrap() {
+                // The second correction measures the contraction again: θ = 1e-4.
+                assert!(c.converged(1e-8).unwrap());
+                let measured = c.error_ratio();
+                assert!((measured - 1e-4 / (1.0 - 1e-4)).abs() <= 1e-12 * measured);
+                break;
+            }
+            ratio = c.error_ratio();
+            steps += 1;
+        }
+        assert_eq!(steps, 3);
+        // A first correction above the own tolerance goes on whatever the ratio says; so does
+        // one with nothing carried (a new step size or model), and Radau IIA's.
+        let mut c = Convergence::new("", &settings, 1.0, 0.1).carrying(eta);
+        assert!(!c.converged(2e-2).unwrap());
+        let mut c = Convergence::new("", &settings, 1.0, 0.1).carrying(f64::INFINITY);
+        assert!(!c.converged(1e-4).unwrap());
+        let mut c = Convergence::new("radauIIA ", &settings, 1.0, 0.1)
+            .correction_only()
+            .carrying(eta);
+        assert!(!c.converged(1e-4).unwrap());
+        // Without a followed tolerance (`carried_below` 0) the plain test alone.
+        let plain = IterationSettings {
+            carried_below: 0.0,
+            ..settings
+        };
+        let mut c = Convergence::new("", &plain, 1.0, 0.1).carrying(eta);
+        assert!(!c.converged(1e-4).unwrap());
+    }
+
+    #[test]
     fn convergence_stops_on_the_estimate_and_refuses_non_finite_corrections() {
         let settings = IterationSettings {
             absolute_tolerance: 1e-6,
+            carried_below: 0.0,
             max_iterations: 10,
             estimate_error: None,
         };

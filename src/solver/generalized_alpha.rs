@@ -283,7 +283,8 @@ fn iterate(
     } = *problem;
     let scheme = matrix.scheme;
     predict(&scheme, problem, h, &ws.previous, state);
-    let mut convergence = Convergence::new("", settings, state.time, h);
+    let mut convergence =
+        Convergence::new("", settings, state.time, h).carrying(ws.previous.iteration_error_ratio);
     ws.anderson.reset();
     // A linear body's step is linear with the iteration matrix as its exact Jacobian: the
     // first correction solves it, up to the solve's forward error (docs/formulation.md, "The
@@ -331,6 +332,7 @@ fn iterate(
                 // the end of the step's, not the predictor's (a linear step stops at once).
                 residual(body, free, state, loads, forces);
             }
+            state.iteration_error_ratio = convergence.error_ratio();
             let error_estimate = settings
                 .estimate_error
                 .map(|enough| matrix.local_error(body, free, &frame, state, ws, forces, enough));

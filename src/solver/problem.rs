@@ -231,6 +231,11 @@ pub struct DynamicState {
     /// (initialization). A step of another length first carries the state over to it
     /// (`generalized_alpha::change_step`).
     pub step_size: f64,
+    /// The error ratio `η = θ/(1−θ)` the iteration of the step that produced this state ended
+    /// with (`fixed_point::Convergence::error_ratio`): the next step of the same length and
+    /// model judges its first correction with it. Infinity: none (initialization, a new step
+    /// length or model).
+    pub iteration_error_ratio: f64,
 }
 
 impl DynamicState {
@@ -244,6 +249,7 @@ impl DynamicState {
             pseudo_acceleration: vec![0.0; dofs],
             multipliers: vec![0.0; multipliers],
             step_size: 0.0,
+            iteration_error_ratio: f64::INFINITY,
         }
     }
 
@@ -257,6 +263,7 @@ impl DynamicState {
             .copy_from_slice(&other.pseudo_acceleration);
         self.multipliers.copy_from_slice(&other.multipliers);
         self.step_size = other.step_size;
+        self.iteration_error_ratio = other.iteration_error_ratio;
     }
 }
 
@@ -279,6 +286,11 @@ pub struct IterationSettings {
     /// largest correction, or after the second iteration its estimated remaining error
     /// (`fixed_point::remaining_error`).
     pub absolute_tolerance: f64,
+    /// A first correction at most this large (m) may stop the iteration on the error ratio
+    /// carried from the step before (`fixed_point::Convergence::carrying`): the iteration's own
+    /// tolerance where a tighter `absolute_tolerance` follows the error control (the first
+    /// correction then leaves what the own tolerance's plain test would); 0: never.
+    pub carried_below: f64,
     pub max_iterations: usize,
     /// `Some(enough)`: the step estimates its local error ([`StepReport::error_estimate`], m;
     /// for the slave's step-size control, docs/formulation.md "Time error control"), and may

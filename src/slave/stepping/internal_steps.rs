@@ -119,6 +119,11 @@ impl Slave {
         }
         let mut settings = IterationSettings {
             absolute_tolerance: floor,
+            carried_below: if tolerance < own_tolerance {
+                own_tolerance * self.size
+            } else {
+                0.0
+            },
             max_iterations: self.parameters.max_iterations.max(1) as usize,
             estimate_error: None,
         };

@@ -45,6 +45,8 @@ pub fn carry_over_force_change(
     tolerance: f64,
 ) -> Carried {
     debug_assert!(!free.is_constrained());
+    // Another internal force: the iteration's contraction is measured again.
+    state.iteration_error_ratio = f64::INFINITY;
     let mut carried = Carried {
         largest: 0.0,
         last: 0.0,

@@ -35,6 +35,8 @@ pub(super) fn change_step(
     state: &mut DynamicState,
 ) {
     let h = state.step_size;
+    // Another iteration matrix: its contraction is measured again.
+    state.iteration_error_ratio = f64::INFINITY;
     let c_v = scheme.beta - scheme.gamma / 2.0 + 1.0 / 12.0;
     let (j_c, omega, centre) = rigid_jerk(body, state);
     let scale = -c_v * (h_new * h_new - h * h);
