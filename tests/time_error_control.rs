@@ -249,12 +249,42 @@ fn a_step_that_would_not_be_estimated_is_no_probe() {
     assert_eq!(s.controlled_step_size(), 0.5 * h, "the control refined");
     let mut bytes = Vec::new();
     flexbody::slave::CoSimSlave::state_to_bytes(&s, &s.get_state(), &mut bytes);
-    // From the payload's end (src/slave/state_bytes.rs): the last internal step, the estimate
-    // floor and the two scales (f64 each), the steps since a motion input jumped (u32) and whether it is sampled (u8), whether
-    // the rung came from a probe (u8), the probe's wait and before it the calm steps (u32 each).
-    let wait_at = bytes.len() - 4 * 8 - 1 - 4 - 1 - 4;
+    // The fields after the probe's wait, to the payload's end, in the writer's order
+    // (src/slave/state_bytes.rs), with their sizes in bytes.
+    let after_wait = [
+        ("whether the rung came from a probe", 1),
+        ("internal steps since a motion input jumped", 4),
+        ("whether the motion is sampled", 1),
+        ("the deformation scale", 8),
+        ("the scale of the modes above the lowest", 8),
+        ("the estimate floor", 8),
+        ("the slabs' stiffening ratio", 8),
+        (
+            "whether model.auto switched the slabs' own stiffening on",
+            1,
+        ),
+        ("when", 8),
+        ("since when the deformation scale has not grown", 8),
+        ("the scale then", 8),
+        ("whether it has settled", 1),
+        ("the last internal step's length", 8),
+        ("whether an iteration's error ratio is carried", 1),
+        ("that ratio", 8),
+    ];
+    let wait_at = bytes.len() - after_wait.iter().map(|(_, n)| n).sum::<usize>() - 4;
     let calm_at = wait_at - 4;
-    let wait = u32::from_le_bytes(bytes[wait_at..wait_at + 4].try_into().unwrap());
+    let level_at = calm_at - 4;
+    let u32_at = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap());
+    // The layout is the writer's: the rung before the calm steps is 1 (0.5 ms of 1 ms), and the
+    // last internal step's length is 0.5 ms.
+    assert_eq!(u32_at(level_at), 1, "the rung's offset");
+    let step_at = bytes.len() - 9 - 8;
+    assert_eq!(
+        f64::from_le_bytes(bytes[step_at..step_at + 8].try_into().unwrap()),
+        0.5 * h,
+        "the last internal step's offset"
+    );
+    let wait = u32_at(wait_at);
     bytes[calm_at..calm_at + 4].copy_from_slice(&wait.to_le_bytes());
     let due = s.state_from_bytes(&bytes).unwrap();
     s.set_state(&due).unwrap();

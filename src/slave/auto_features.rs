@@ -207,6 +207,8 @@ pub(super) fn choose_driven_stiffening(
             },
         });
         *quiet = NOT_QUIET;
+        // Another model's terms: the iteration's contraction is measured again.
+        dynamics.state.iteration_error_ratio = f64::INFINITY;
     }
 }
 

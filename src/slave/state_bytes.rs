@@ -540,11 +540,16 @@ impl Slave {
                         "the serialized FMU state holds {step_size} for the last internal step's length: not finite and at least 0"
                     )));
                 }
-                let carried = r.u8("whether an iteration's error ratio is carried")? != 0;
+                let carried = r.boolean("whether an iteration's error ratio is carried")?;
                 let ratio = r.f64("the iteration's error ratio")?;
-                if ratio < 0.0 {
+                // `θ/(1 − θ)` with `θ ≤ 0.5`, or that grown by a power below 1: in [0, 1];
+                // carried only after a step of the length given.
+                if !(0.0..=1.0).contains(&ratio)
+                    || (!carried && ratio != 0.0)
+                    || (carried && step_size == 0.0)
+                {
                     return Err(Error::new(format!(
-                        "the serialized FMU state holds {ratio} for the iteration's error ratio: not at least 0"
+                        "the serialized FMU state holds {ratio} for the iteration's error ratio (carried: {carried}, after a step of {step_size} s): not in [0, 1], 0 when not carried, carried only after a step"
                     )));
                 }
                 let iteration_error_ratio = if carried { ratio } else { f64::INFINITY };

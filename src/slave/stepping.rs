@@ -72,6 +72,12 @@ impl Slave {
         };
         // What a failed step puts back besides the state and the driving frames.
         let before = StepStart::of(self.dynamics.as_ref().unwrap(), self.events.len());
+        if self.inputs_jumped {
+            // A jump's first correction is larger than the one the carried ratio was measured
+            // after, and the iteration's contraction grows with it (docs/formulation.md, "The
+            // stopping rule"): measured again.
+            self.dynamics.as_mut().unwrap().state.iteration_error_ratio = f64::INFINITY;
+        }
         // Whether the backup holds this step's start (an error before it must not restore it).
         let mut backed_up = false;
         // A probe takes this step on the rung above (step_control, "probes"), if the step's

@@ -56,7 +56,7 @@ pub fn error_ratio(correction: f64, previous_correction: f64) -> f64 {
 /// predecessor's iteration ended with (Hairer & Wanner, *Solving ODEs II*, IV.8):
 /// `η₀ = max(η, ε)^0.8`, `ε` the machine epsilon. The power lets a ratio carried over steps
 /// that stop on their first correction grow, so that every few steps a second correction
-/// measures it again (1e-6 grows past 1e-2 in six steps).
+/// measures it again (1e-6 grows past 1e-2 in five steps).
 pub fn carried_error_ratio(previous: f64) -> f64 {
     previous.max(f64::EPSILON).powf(CARRIED_GROWTH)
 }
@@ -106,6 +106,12 @@ pub struct Convergence {
     /// The error ratio `η` ([`error_ratio`]) of the last iteration, or before the second the
     /// one carried from the previous step ([`carried_error_ratio`]; infinity: none).
     ratio: f64,
+    /// The ratio to carry to the next step ([`Self::error_ratio`]): the second correction's
+    /// against the first, both plain (Anderson's mixing starts with the second update), or
+    /// before the second the one carried.
+    carry: f64,
+    /// Corrections judged so far.
+    corrections: u32,
 }
 
 impl Convergence {
@@ -124,6 +130,8 @@ impl Convergence {
             last_correction: f64::INFINITY,
             trust_estimate: true,
             ratio: f64::INFINITY,
+            carry: f64::INFINITY,
+            corrections: 0,
         }
     }
 
@@ -135,13 +143,15 @@ impl Convergence {
     /// carries nothing.
     pub fn carrying(mut self, previous: f64) -> Convergence {
         self.ratio = carried_error_ratio(previous);
+        self.carry = self.ratio;
         self
     }
 
-    /// The error ratio `η` to carry to the next step: the last one measured, or if the step
+    /// The error ratio `η` to carry to the next step: the second correction's against the
+    /// first (a later one's contraction is that of Anderson's mixed iterates), or if the step
     /// stopped on its first correction the one it was judged with.
     pub fn error_ratio(&self) -> f64 {
-        self.ratio
+        self.carry
     }
 
     /// The same tracker accepting on the correction alone (`Δ_k ≤ tol`), never on the estimate.
@@ -168,8 +178,12 @@ impl Convergence {
             )));
         }
         let tolerance = self.settings.absolute_tolerance;
+        self.corrections += 1;
         if self.last_correction.is_finite() {
             self.ratio = error_ratio(largest, self.last_correction);
+            if self.corrections == 2 {
+                self.carry = self.ratio;
+            }
         }
         // A ratio measured in this step's iteration judges its correction as it is; one carried
         // from the step before is a prediction: it judges a first correction with a margin, and
@@ -282,6 +296,17 @@ mod tests {
             .correction_only()
             .carrying(eta);
         assert!(!c.converged(1e-4).unwrap());
+        // What is carried on is the second correction's ratio to the first: a third one's is
+        // that of Anderson's mixed iterates.
+        let mut c = Convergence::new("", &settings, 1.0, 0.1).carrying(f64::INFINITY);
+        assert!(!c.converged(1.0).unwrap());
+        assert!(!c.converged(0.1).unwrap());
+        assert!(c.converged(1e-7).unwrap());
+        assert!(
+            (c.error_ratio() - 0.1 / 0.9).abs() <= 1e-12,
+            "{}",
+            c.error_ratio()
+        );
         // Without a followed tolerance (`carried_below` 0) the plain test alone.
         let plain = IterationSettings {
             carried_below: 0.0,

@@ -283,8 +283,14 @@ fn iterate(
     } = *problem;
     let scheme = matrix.scheme;
     predict(&scheme, problem, h, &ws.previous, state);
-    let mut convergence =
-        Convergence::new("", settings, state.time, h).carrying(ws.previous.iteration_error_ratio);
+    // Newton's matrix is refactored at every iteration: its last contraction says nothing of
+    // the next step's first correction.
+    let carried = if matrix.newton.is_none() {
+        ws.previous.iteration_error_ratio
+    } else {
+        f64::INFINITY
+    };
+    let mut convergence = Convergence::new("", settings, state.time, h).carrying(carried);
     ws.anderson.reset();
     // A linear body's step is linear with the iteration matrix as its exact Jacobian: the
     // first correction solves it, up to the solve's forward error (docs/formulation.md, "The

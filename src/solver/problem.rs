@@ -283,8 +283,9 @@ pub struct StepReport {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IterationSettings {
     /// Converged when the estimated position error of the iterate is below this (m): the
-    /// largest correction, or after the second iteration its estimated remaining error
-    /// (`fixed_point::remaining_error`).
+    /// largest correction, or from the second iteration on its estimated remaining error
+    /// (`fixed_point::remaining_error`), or on the first with the ratio carried from the step
+    /// before (below, [`Self::carried_below`]).
     pub absolute_tolerance: f64,
     /// A first correction at most this large (m) may stop the iteration on the error ratio
     /// carried from the step before (`fixed_point::Convergence::carrying`): the iteration's own

@@ -17,6 +17,9 @@ pub(super) struct StepStart {
     slab_stiffening_since: Option<f64>,
     pub(super) features: Features,
     quiet_since: [f64; 3],
+    /// The iteration's error ratio carried into the step (`DynamicState::iteration_error_ratio`;
+    /// the step may forget it before its backup is taken: an input's jump, a model change).
+    iteration_error_ratio: f64,
     /// The log events queued before the step: the decisions it logged after them
     /// (`model.auto`'s switches, `model.accuracy`'s rungs) are undone with it.
     events: usize,
@@ -32,6 +35,7 @@ impl StepStart {
             slab_stiffening_since: dynamics.slab_stiffening_since,
             features: dynamics.features,
             quiet_since: dynamics.quiet_since,
+            iteration_error_ratio: dynamics.state.iteration_error_ratio,
             events,
         }
     }
@@ -50,6 +54,7 @@ impl StepStart {
         dynamics.slab_stiffening_since = self.slab_stiffening_since;
         dynamics.features = self.features;
         dynamics.quiet_since = self.quiet_since;
+        dynamics.state.iteration_error_ratio = self.iteration_error_ratio;
         if let Some(model) = model {
             model.apply_features(self.features);
         }
