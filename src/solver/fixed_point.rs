@@ -179,7 +179,7 @@ impl Convergence {
         }
         let tolerance = self.settings.absolute_tolerance;
         self.corrections += 1;
-        if self.last_correction.is_finite() {
+        if self.corrections > 1 {
             self.ratio = error_ratio(largest, self.last_correction);
             if self.corrections == 2 {
                 self.carry = self.ratio;
@@ -188,7 +188,7 @@ impl Convergence {
         // A ratio measured in this step's iteration judges its correction as it is; one carried
         // from the step before is a prediction: it judges a first correction with a margin, and
         // only one the plain test would pass at `carried_below`.
-        let estimated = if self.last_correction.is_finite() {
+        let estimated = if self.corrections > 1 {
             self.ratio * largest <= tolerance
         } else {
             largest <= self.settings.carried_below
