@@ -4,7 +4,8 @@
 //! deforms, a tip interface) tumbles at `model.accuracy = 1e-4`, at the origin and placed
 //! 100 m and 1 km away; its tip's motion relative to its body frame is the same.
 
-use flexbody::model::BodyFile;
+mod common;
+use common::*;
 use flexbody::slave::Slave;
 use nalgebra::{Matrix3, Vector3};
 
@@ -12,36 +13,26 @@ use nalgebra::{Matrix3, Vector3};
 /// statistics (internal steps, iterations) and whether the iteration's tolerance followed the
 /// error control.
 fn tumbling_tip(offset: f64, end: f64) -> (Vec<Vector3<f64>>, (u64, u64), bool) {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/tumbling.json"
-    ))
-    .unwrap();
-    let mut file = BodyFile::from_json(&text).unwrap();
+    let mut file = example_body("tumbling");
     let tip = r#"{ "name": "tip", "kind": "force", "nodes": { "plane": { "point": [1.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0] } }, "referencePoint": [1.0, 0.0, 0.0] }"#;
     file.interfaces.push(serde_json::from_str(tip).unwrap());
     let mut s = Slave::from_body(file).unwrap();
     s.setup_experiment(0.0, Some(end), None).unwrap();
     s.enter_initialization_mode().unwrap();
-    s.set_by_name("model.accuracy", 1e-4).unwrap();
-    s.set_by_name("material.youngsModulus", 2.1e8).unwrap();
+    set(&mut s, "model.accuracy", 1e-4);
+    set(&mut s, "material.youngsModulus", 2.1e8);
     // Spinning about an axis through the body's point (0.5, 0, 0), placed `offset` along x.
     let w = Vector3::new(0.5, 3.0, 7.0);
     let v = -w.cross(&Vector3::new(0.5, 0.0, 0.0));
     for k in 0..3 {
-        s.set_by_name(&format!("initial.angularVelocity[{}]", k + 1), w[k])
-            .unwrap();
-        s.set_by_name(&format!("initial.velocity[{}]", k + 1), v[k])
-            .unwrap();
+        set(&mut s, &format!("initial.angularVelocity[{}]", k + 1), w[k]);
+        set(&mut s, &format!("initial.velocity[{}]", k + 1), v[k]);
     }
-    s.set_by_name("initial.position[1]", offset).unwrap();
+    set(&mut s, "initial.position[1]", offset);
     s.exit_initialization_mode().unwrap();
     let local_tip = |s: &mut Slave| {
-        let mut get = |name: String| s.get_by_name(&name).unwrap();
-        let r = Matrix3::from_fn(|i, j| get(format!("body.rotation[{}]", 3 * i + j + 1)));
-        let c = Vector3::from_fn(|i, _| get(format!("body.position[{}]", i + 1)));
-        let x = Vector3::from_fn(|i, _| get(format!("tip.position[{}]", i + 1)));
-        r.transpose() * (x - c)
+        let r = Matrix3::from_fn(|i, j| get(s, &format!("body.rotation[{}]", 3 * i + j + 1)));
+        r.transpose() * (vector(s, "tip.position") - vector(s, "body.position"))
     };
     let start = local_tip(&mut s);
     let dt = 1e-2;

@@ -7,7 +7,7 @@
 //!
 //! - is converged when `Δ_k ≤ tol`, or (generalized-α; not Radau IIA, see
 //!   [`Convergence::correction_only`]) when the error estimate of a linearly converging
-//!   iteration, `θ/(1−θ) Δ_k` with `θ = Δ_k/Δ_{k−1}` ([`remaining_error`]), is `≤ tol`; on the
+//!   iteration, `θ/(1−θ) Δ_k` with `θ = Δ_k/Δ_{k−1}` ([`error_ratio`]), is `≤ tol`; on the
 //!   first correction, with the ratio the step before ended with ([`Convergence::carrying`]),
 //!   when `η₀ Δ₁ ≤ 0.1 tol` ([`CARRIED_MARGIN`]) and `Δ₁` is within the iteration's own
 //!   tolerance where `tol` follows the error control below it;
@@ -21,28 +21,17 @@ use super::problem::IterationSettings;
 use crate::error::{Error, Result};
 
 /// The largest contraction `θ = ‖Δ_k‖/‖Δ_{k−1}‖` of successive corrections for which the
-/// error estimate [`remaining_error`] is trusted (Hairer & Wanner, *Solving ODEs II*, IV.8: the
+/// error estimate `η ‖Δ_k‖` ([`error_ratio`]) is trusted (Hairer & Wanner, *Solving ODEs II*, IV.8: the
 /// simplified Newton iteration of implicit Runge–Kutta methods stops on this estimate). Above it
 /// the iteration runs until the correction itself is below the tolerance.
 pub const TRUSTED_CONTRACTION: f64 = 0.5;
 
-/// The position error left after applying correction `Δ_k` of a linearly converging iteration
-/// with contraction `θ = ‖Δ_k‖/‖Δ_{k−1}‖`: the corrections still to come sum to at most
-/// `θ/(1−θ) ‖Δ_k‖` (infinity when `θ` exceeds [`TRUSTED_CONTRACTION`] or is unknown). With the
+/// The error ratio `η = θ/(1−θ)` of a linearly converging iteration with contraction
+/// `θ = ‖Δ_k‖/‖Δ_{k−1}‖`: after applying correction `Δ_k` the corrections still to come sum to at
+/// most `η ‖Δ_k‖` (infinity when `θ` exceeds [`TRUSTED_CONTRACTION`] or is unknown). With the
 /// constant iteration matrix `θ` is small (the rotation of the frame over a step: 1e-4 to 1e-6 on
-/// B1), so this accepts after two iterations a step that the correction alone accepts after
-/// three, with an estimated error far below the tolerance.
-pub fn remaining_error(correction: f64, previous_correction: f64) -> f64 {
-    let ratio = error_ratio(correction, previous_correction);
-    if ratio.is_finite() {
-        ratio * correction
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// `η = θ/(1−θ)` of [`remaining_error`] with `θ = ‖Δ_k‖/‖Δ_{k−1}‖`: the error left after a
-/// correction in units of it (infinity when `θ` exceeds [`TRUSTED_CONTRACTION`] or is unknown).
+/// B1), so `η ‖Δ_k‖ ≤ tol` accepts after two iterations a step that the correction alone accepts
+/// after three, with an estimated error far below the tolerance.
 pub fn error_ratio(correction: f64, previous_correction: f64) -> f64 {
     let theta = correction / previous_correction;
     if previous_correction.is_finite() && theta.is_finite() && theta <= TRUSTED_CONTRACTION {
@@ -100,7 +89,7 @@ pub struct Convergence {
     step_size: f64,
     /// The largest position correction of the last iteration (∞ before the first).
     last_correction: f64,
-    /// Whether the estimate [`remaining_error`] may accept an iterate (see
+    /// Whether the estimate `η ‖Δ_k‖` ([`error_ratio`]) may accept an iterate (see
     /// [`Self::correction_only`]).
     trust_estimate: bool,
     /// The error ratio `η` ([`error_ratio`]) of the last iteration, or before the second the
@@ -167,8 +156,8 @@ impl Convergence {
     }
 
     /// Judges an iteration whose plain correction has the largest position entry `largest`
-    /// ([`largest_correction`]): `Ok(true)` when converged (the correction or its
-    /// [`remaining_error`] is within the tolerance), `Ok(false)` when the iteration goes on, a
+    /// ([`largest_correction`]): `Ok(true)` when converged (the correction or `η` times it,
+    /// [`error_ratio`], is within the tolerance), `Ok(false)` when the iteration goes on, a
     /// discard when the correction is not finite.
     pub fn converged(&mut self, largest: f64) -> Result<bool> {
         if !largest.is_finite() {
@@ -231,7 +220,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn remaining_error_of_a_contraction() {
+    fn error_ratio_of_a_contraction() {
         // x_{k+1} = θ x_k: after a correction Δ the corrections still to come sum to
         // θ/(1−θ) Δ exactly.
         let theta: f64 = 0.1;
@@ -239,17 +228,17 @@ mod tests {
         for k in 1..5 {
             let still_to_come: f64 =
                 corrections[k + 1..].iter().sum::<f64>() + theta.powi(6) / (1.0 - theta); // the tail beyond the sample
-            let estimate = remaining_error(corrections[k], corrections[k - 1]);
+            let estimate = error_ratio(corrections[k], corrections[k - 1]) * corrections[k];
             assert!(
                 (estimate - still_to_come).abs() <= 1e-12 * still_to_come,
                 "{estimate} {still_to_come}"
             );
         }
         // No estimate from the first correction, a slow or a diverging iteration.
-        assert_eq!(remaining_error(1e-3, f64::INFINITY), f64::INFINITY);
-        assert_eq!(remaining_error(0.6, 1.0), f64::INFINITY);
-        assert_eq!(remaining_error(2.0, 1.0), f64::INFINITY);
-        assert_eq!(remaining_error(f64::NAN, 1.0), f64::INFINITY);
+        assert_eq!(error_ratio(1e-3, f64::INFINITY), f64::INFINITY);
+        assert_eq!(error_ratio(0.6, 1.0), f64::INFINITY);
+        assert_eq!(error_ratio(2.0, 1.0), f64::INFINITY);
+        assert_eq!(error_ratio(f64::NAN, 1.0), f64::INFINITY);
     }
 
     #[test]

@@ -284,7 +284,7 @@ pub struct StepReport {
 pub struct IterationSettings {
     /// Converged when the estimated position error of the iterate is below this (m): the
     /// largest correction, or from the second iteration on its estimated remaining error
-    /// (`fixed_point::remaining_error`), or on the first with the ratio carried from the step
+    /// (`fixed_point::error_ratio`), or on the first with the ratio carried from the step
     /// before (below, [`Self::carried_below`]).
     pub absolute_tolerance: f64,
     /// A first correction at most this large (m) may stop the iteration on the error ratio
